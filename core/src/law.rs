@@ -1,0 +1,123 @@
+//! The cohesive-law contract.
+//!
+//! A cohesive law maps the displacement jump across an interface, the *gap*
+//! `[normal opening, tangential slip]` in mm, to the traction `[normal, shear]` in MPa, given the
+//! history of the integration point. Laws are stateless values (their parameters); the history lives
+//! in a small [`LawState`] that the caller stores per integration point and commits only once a
+//! load step has converged.
+
+use crate::error::{CzError, Result};
+use nalgebra::{Matrix2, Vector2};
+use serde::{Deserialize, Serialize};
+
+/// Displacement jump `[normal opening u_n, tangential slip u_t]` in mm. Positive `u_n` opens.
+pub type Gap = Vector2<f64>;
+/// Traction `[T_n, T_t]` in MPa, work-conjugate to [`Gap`].
+pub type Traction = Vector2<f64>;
+/// Consistent tangent `∂T_i/∂u_j` in MPa/mm (row i: traction component, column j: gap component).
+/// Generally unsymmetric while damage grows.
+pub type Tangent = Matrix2<f64>;
+
+/// History of one integration point.
+///
+/// `damage` is kept current by every law (0 intact, 1 fully separated) so that forward models can
+/// measure debonded and process-zone lengths without knowing the law. `history` holds whatever
+/// else a law needs (e.g. the largest effective opening reached); its meaning is the law's own.
+#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct LawState {
+    /// Damage D ∈ [0, 1], non-decreasing.
+    pub damage: f64,
+    /// Law-specific history variables.
+    pub history: [f64; 3],
+}
+
+/// What a law returns for a trial gap: traction, consistent tangent, and the trial state that
+/// becomes the committed state once the step converges.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LawEval {
+    /// Traction (MPa).
+    pub traction: Traction,
+    /// `∂T/∂u` (MPa/mm).
+    pub tangent: Tangent,
+    /// Trial history.
+    pub state: LawState,
+}
+
+/// One parameter of a law, for reports and parameter spaces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterInfo {
+    /// Key in configuration files (also the parameter-space path below `law.`).
+    pub name: &'static str,
+    /// Current value.
+    pub value: f64,
+    /// Physical unit, e.g. `"MPa"`, `"mm"`, `"N/mm"`.
+    pub unit: &'static str,
+    /// One line on what it means.
+    pub meaning: &'static str,
+}
+
+/// A traction–separation law of a zero-thickness interface.
+///
+/// Object safe and registered with `typetag`: a `Box<dyn CohesiveLaw>` (de)serialises with a
+/// `type = "..."` key, so users add laws in their own crates with
+/// `#[typetag::serde(name = "my_law")] impl CohesiveLaw for MyLaw { ... }`.
+///
+/// Contract (checked for every bundled law by the test suite):
+/// * `evaluate` is pure: it never mutates the law and depends only on `gap` and `previous`;
+/// * the returned tangent is the derivative of the returned traction with respect to the gap,
+///   holding `previous` fixed (the consistent tangent Newton needs);
+/// * `state.damage` never decreases and stays in [0, 1];
+/// * on pure-mode paths to complete failure, `∫ T du` equals [`CohesiveLaw::fracture_energy`].
+#[typetag::serde(tag = "type")]
+pub trait CohesiveLaw: Send + Sync + std::fmt::Debug {
+    /// Checks the parameters; returns an error naming the first invalid one.
+    fn validate(&self) -> Result<()>;
+
+    /// Traction, tangent and trial state at `gap`, starting from the committed state `previous`.
+    fn evaluate(&self, gap: &Gap, previous: &LawState) -> LawEval;
+
+    /// Critical energy release rates `[G_Ic, G_IIc]` in N/mm (energy to separate in pure mode).
+    fn fracture_energy(&self) -> [f64; 2];
+
+    /// Initial (penalty) stiffnesses `[k_n, k_t]` in MPa/mm.
+    fn initial_stiffness(&self) -> [f64; 2];
+
+    /// Pure-mode peak tractions `[σ_n, σ_t]` in MPa.
+    fn strength(&self) -> [f64; 2];
+
+    /// The law's parameters with units, in configuration-file order.
+    fn parameters(&self) -> Vec<ParameterInfo>;
+
+    /// State of an undamaged point.
+    fn initial_state(&self) -> LawState {
+        LawState::default()
+    }
+
+    /// Recoverable (elastic) energy per unit area stored at `gap` in `state` (N/mm).
+    ///
+    /// The default, `½ T·u`, is exact for laws that unload along the secant to the origin and
+    /// for a linear compression penalty; laws with other unloading must override it. Forward models
+    /// compute dissipated energy as work done minus this.
+    fn stored_energy(&self, gap: &Gap, state: &LawState) -> f64 {
+        0.5 * self.evaluate(gap, state).traction.dot(gap)
+    }
+}
+
+/// Reads a law from TOML (a table with a `type` key) and validates it.
+///
+/// ```
+/// # use czid_core::law_from_toml;
+/// let err = law_from_toml("type = \"no_such_law\"").unwrap_err();
+/// assert!(err.to_string().contains("no_such_law"));
+/// ```
+pub fn law_from_toml(text: &str) -> Result<Box<dyn CohesiveLaw>> {
+    let law: Box<dyn CohesiveLaw> =
+        toml::from_str(text).map_err(|e| CzError::config("law", e.to_string().trim_end().to_string()))?;
+    law.validate()?;
+    Ok(law)
+}
+
+/// Writes a law as a TOML table with its `type` key.
+pub fn law_to_toml(law: &dyn CohesiveLaw) -> Result<String> {
+    toml::to_string(law).map_err(|e| CzError::config("law", e.to_string()))
+}

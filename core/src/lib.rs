@@ -1,0 +1,37 @@
+//! # czid-core: the vocabulary of czid
+//!
+//! Everything else in czid is written in these terms:
+//!
+//! * [`CohesiveLaw`]: traction–separation law of an interface (per integration point history,
+//!   traction and consistent tangent for a two-component gap). Object safe and registered with
+//!   `typetag`, so configuration files name a law by `type = "..."`.
+//! * [`ForwardModel`]: a simulated test (DCB, ENF, FRP beam, ...) that runs with any law and returns a
+//!   [`Record`] of named, unit-carrying columns per converged step.
+//! * [`Response`]: a curve extracted from a record (load vs displacement, debonded length vs
+//!   displacement, ...), compared with experimental [`Curve`]s by the [`CompositeObjective`]
+//!   (Eq. 14–18 of Shi & Zhang).
+//! * [`ParameterSpace`]: named parameters with units, bounds and optional log scale, mapping an
+//!   optimizer's vector onto a configured law or model and back.
+//! * [`Optimizer`] and [`Problem`]: the contract between search methods and what they minimise.
+//!
+//! Units are N, mm and MPa (N/mm²) throughout; energies per unit area are N/mm.
+
+pub mod curve;
+pub mod error;
+pub mod law;
+pub mod model;
+pub mod objective;
+pub mod optimizer;
+pub mod param;
+pub mod record;
+pub mod response;
+
+pub use curve::Curve;
+pub use error::{CzError, Result};
+pub use law::{law_from_toml, law_to_toml, CohesiveLaw, Gap, LawEval, LawState, ParameterInfo, Tangent, Traction};
+pub use model::{ForwardModel, SimulationFailure};
+pub use objective::{CompositeObjective, ObjectiveTerm, ObjectiveValue};
+pub use optimizer::{Budget, Evaluation, NoObserver, Observer, OptimizationResult, Optimizer, Problem, Progress};
+pub use param::{Parameter, ParameterSpace, Scale};
+pub use record::{columns, Column, Record};
+pub use response::{ColumnResponse, Response};

@@ -1,0 +1,36 @@
+//! The forward-model contract.
+
+use crate::error::CzError;
+use crate::law::CohesiveLaw;
+use crate::record::Record;
+
+/// A simulation that failed part way: the error, and the steps that did converge.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimulationFailure {
+    /// Why it stopped.
+    pub error: CzError,
+    /// The converged steps before the failure (possibly empty).
+    pub partial: Record,
+}
+
+impl std::fmt::Display for SimulationFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} (after {} converged steps)", self.error, self.partial.rows())
+    }
+}
+
+impl std::error::Error for SimulationFailure {}
+
+/// A simulated test that runs with any cohesive law.
+///
+/// The model owns its geometry, materials, loading and switchable physical effects; the law is
+/// passed per run so that an identification can try thousands of laws on one model (which may
+/// cache its mesh and symbolic factorisation across runs).
+pub trait ForwardModel: Send + Sync {
+    /// Short name, e.g. `"dcb"`.
+    fn name(&self) -> &str;
+
+    /// Runs the test with `law`; returns one row per converged step with at least the columns
+    /// of [`crate::columns`] that the model measures.
+    fn simulate(&self, law: &dyn CohesiveLaw) -> Result<Record, SimulationFailure>;
+}

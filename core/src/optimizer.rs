@@ -1,0 +1,120 @@
+//! The contract between search methods and what they minimise.
+
+use crate::error::Result;
+use serde::{Deserialize, Serialize};
+
+/// The outcome of evaluating one candidate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Evaluation {
+    /// Scalar value minimised by single-objective methods (the weighted composite `f`).
+    pub value: f64,
+    /// Separate objectives for multi-objective methods (e.g. `[||φ_F||², ||φ_L||²]`); empty
+    /// when the problem has only `value`.
+    pub objectives: Vec<f64>,
+    /// Residual vector with `value = ||residuals||²`, for least-squares methods; empty when not
+    /// available.
+    pub residuals: Vec<f64>,
+}
+
+impl Evaluation {
+    /// A scalar-only evaluation.
+    pub fn scalar(value: f64) -> Self {
+        Evaluation { value, objectives: Vec::new(), residuals: Vec::new() }
+    }
+}
+
+/// A bounded minimisation problem.
+///
+/// `evaluate` may fail (e.g. a forward model that does not converge): optimizers count and
+/// penalise failures, they never abort on them.
+pub trait Problem: Sync {
+    /// Number of variables.
+    fn dim(&self) -> usize;
+    /// Box bounds `(lower, upper)` per variable.
+    fn bounds(&self) -> Vec<(f64, f64)>;
+    /// Evaluates a candidate.
+    fn evaluate(&self, x: &[f64]) -> Result<Evaluation>;
+    /// Number of separate objectives in [`Evaluation::objectives`] (1 when only `value`).
+    fn objectives(&self) -> usize {
+        1
+    }
+}
+
+/// When to stop.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Budget {
+    /// Maximum number of objective evaluations.
+    pub evaluations: usize,
+    /// Stop once the best value is at or below this.
+    pub target: Option<f64>,
+}
+
+impl Budget {
+    /// A budget of `evaluations` with no target.
+    pub fn evaluations(evaluations: usize) -> Self {
+        Budget { evaluations, target: None }
+    }
+}
+
+/// Progress of a run, reported to [`Observer`]s after each iteration or generation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progress<'a> {
+    /// Iteration or generation index (from 0).
+    pub iteration: usize,
+    /// Evaluations spent so far.
+    pub evaluations: usize,
+    /// Failed evaluations so far.
+    pub failures: usize,
+    /// Best value so far.
+    pub best_value: f64,
+    /// Best point so far.
+    pub best_x: &'a [f64],
+}
+
+/// Watches a run (progress bars, history files, checkpoints). Returning `false` asks the
+/// optimizer to stop after the current iteration.
+pub trait Observer {
+    /// Called after each iteration.
+    fn observe(&mut self, progress: &Progress<'_>) -> bool;
+}
+
+/// An observer that does nothing.
+pub struct NoObserver;
+
+impl Observer for NoObserver {
+    fn observe(&mut self, _: &Progress<'_>) -> bool {
+        true
+    }
+}
+
+/// What an optimizer returns.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OptimizationResult {
+    /// Best point found.
+    pub best_x: Vec<f64>,
+    /// Its evaluation.
+    pub best: Evaluation,
+    /// Evaluations spent.
+    pub evaluations: usize,
+    /// Evaluations that failed.
+    pub failures: usize,
+    /// Best value after each iteration: `(evaluations so far, best value)`.
+    pub history: Vec<(usize, f64)>,
+    /// Non-dominated set for multi-objective methods: `(x, evaluation)`.
+    pub pareto: Vec<(Vec<f64>, Evaluation)>,
+}
+
+/// A search method.
+pub trait Optimizer {
+    /// Short name, e.g. `"miga"`.
+    fn name(&self) -> &str;
+    /// Minimises `problem` within `budget`; the same `seed` gives the same result whatever the
+    /// number of threads.
+    fn minimize(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        seed: u64,
+        observer: &mut dyn Observer,
+    ) -> Result<OptimizationResult>;
+}

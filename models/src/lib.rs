@@ -1,0 +1,6 @@
+//! # czid-models: cohesive laws and forward models
+//!
+//! * [`laws`]: ST-CZM (Nairn & Aimene), bilinear mixed mode (Camanho–Dávila, BK), exponential
+//!   (Xu–Needleman) and a bridging (R-curve) law, all behind [`czid_core::CohesiveLaw`].
+
+pub mod laws;

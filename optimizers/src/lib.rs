@@ -1,0 +1,1 @@
+//! # czid-optimizers: search methods behind [`czid_core::Optimizer`]

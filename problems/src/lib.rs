@@ -1,0 +1,1 @@
+//! # czid-problems: inverse problems built from laws, forward models and optimizers
