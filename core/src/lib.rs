@@ -31,7 +31,9 @@ pub use error::{CzError, Result};
 pub use law::{law_from_toml, law_to_toml, CohesiveLaw, Gap, LawEval, LawState, ParameterInfo, Tangent, Traction};
 pub use model::{ForwardModel, SimulationFailure};
 pub use objective::{CompositeObjective, ObjectiveTerm, ObjectiveValue};
-pub use optimizer::{Budget, Evaluation, NoObserver, Observer, OptimizationResult, Optimizer, Problem, Progress};
+pub use optimizer::{
+    Budget, Evaluation, NoObserver, Observer, OptimizationResult, Optimizer, Problem, Progress, Snapshot,
+};
 pub use param::{Parameter, ParameterSpace, Scale};
 pub use record::{columns, Column, Record};
 pub use response::{ColumnResponse, Response};

@@ -71,11 +71,36 @@ pub struct Progress<'a> {
     pub best_x: &'a [f64],
 }
 
+/// The resumable state of a run, serialised only when an observer asks for it (so runs that
+/// are not checkpointed pay nothing).
+pub trait Snapshot {
+    /// The state as JSON, accepted back by [`Optimizer::resume`].
+    fn to_json(&self) -> Result<String>;
+}
+
 /// Watches a run (progress bars, history files, checkpoints). Returning `false` asks the
 /// optimizer to stop after the current iteration.
 pub trait Observer {
     /// Called after each iteration.
     fn observe(&mut self, progress: &Progress<'_>) -> bool;
+
+    /// Called after each iteration, before [`Observer::observe`], by optimizers that can resume:
+    /// `state` resumes the run exactly where it stands. The default ignores it; a checkpoint
+    /// writer saves it. An error (e.g. a full disk) stops the run.
+    fn checkpoint(&mut self, progress: &Progress<'_>, state: &dyn Snapshot) -> Result<()> {
+        let _ = (progress, state);
+        Ok(())
+    }
+}
+
+impl<T: Observer + ?Sized> Observer for &mut T {
+    fn observe(&mut self, progress: &Progress<'_>) -> bool {
+        (**self).observe(progress)
+    }
+
+    fn checkpoint(&mut self, progress: &Progress<'_>, state: &dyn Snapshot) -> Result<()> {
+        (**self).checkpoint(progress, state)
+    }
 }
 
 /// An observer that does nothing.
@@ -98,7 +123,9 @@ pub struct OptimizationResult {
     pub evaluations: usize,
     /// Evaluations that failed.
     pub failures: usize,
-    /// Best value after each iteration: `(evaluations so far, best value)`.
+    /// Every improvement of the best value: `(evaluations so far, best value)`, where the
+    /// count includes the evaluation that found it (so the best-so-far curve is exact per
+    /// evaluation); the last entry is `(evaluations, best.value)`.
     pub history: Vec<(usize, f64)>,
     /// Non-dominated set for multi-objective methods: `(x, evaluation)`.
     pub pareto: Vec<(Vec<f64>, Evaluation)>,
@@ -117,4 +144,18 @@ pub trait Optimizer {
         seed: u64,
         observer: &mut dyn Observer,
     ) -> Result<OptimizationResult>;
+
+    /// Continues a run from a state saved through [`Observer::checkpoint`], with a possibly
+    /// different budget; the final result equals that of an uninterrupted run. Optimizers that
+    /// cannot resume keep this default, which says so.
+    fn resume(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        state: &str,
+        observer: &mut dyn Observer,
+    ) -> Result<OptimizationResult> {
+        let _ = (problem, budget, state, observer);
+        Err(crate::error::CzError::Optimizer(format!("optimizer `{}` cannot resume from a checkpoint", self.name())))
+    }
 }
