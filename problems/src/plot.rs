@@ -213,11 +213,7 @@ impl Figure {
         root.fill(&WHITE).map_err(err)?;
         let ((x0, x1), (y0, y1)) = self.ranges();
         let mut builder = ChartBuilder::on(&root);
-        builder
-            .caption(&self.title, ("sans-serif", 24))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(70);
+        builder.caption(&self.title, ("sans-serif", 24)).margin(15).x_label_area_size(45).y_label_area_size(70);
         if self.log_y {
             let mut chart = builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(err)?;
             chart
@@ -264,13 +260,12 @@ impl Figure {
                 poly.extend(s.x.iter().zip(lo).rev().filter(|(x, y)| ok(**x, **y)).map(|(x, y)| (*x, *y)));
                 chart.draw_series(std::iter::once(Polygon::new(poly, color.mix(0.2).filled()))).map_err(err)?;
             }
-            let pts: Vec<(f64, f64)> = s.x.iter().zip(&s.y).filter(|(x, y)| ok(**x, **y)).map(|(x, y)| (*x, *y)).collect();
+            let pts: Vec<(f64, f64)> =
+                s.x.iter().zip(&s.y).filter(|(x, y)| ok(**x, **y)).map(|(x, y)| (*x, *y)).collect();
             let style = ShapeStyle::from(&color).stroke_width(2);
             let anno = match s.mark {
                 Mark::Line => chart.draw_series(LineSeries::new(pts, style)).map_err(err)?,
-                Mark::Dashed => {
-                    chart.draw_series(DashedLineSeries::new(pts, 8, 5, style)).map_err(err)?
-                }
+                Mark::Dashed => chart.draw_series(DashedLineSeries::new(pts, 8, 5, style)).map_err(err)?,
                 Mark::Points => {
                     chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 2, color.filled()))).map_err(err)?
                 }

@@ -1,0 +1,317 @@
+//! Experimental data: a test's curves read from a CSV file, checked, and converted to N and mm.
+//!
+//! Every problem with the file is reported with the file name, the row (1-based, counting the
+//! header as row 1, as a spreadsheet shows it) and the column, and what is expected instead.
+
+use czid_core::{Curve, CzError, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Unit of a length column.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LengthUnit {
+    /// Millimetres (czid's unit).
+    #[default]
+    #[serde(rename = "mm")]
+    Millimetre,
+    /// Metres.
+    #[serde(rename = "m")]
+    Metre,
+    /// Inches.
+    #[serde(rename = "in")]
+    Inch,
+}
+
+impl LengthUnit {
+    /// Factor to millimetres.
+    pub fn to_mm(self) -> f64 {
+        match self {
+            LengthUnit::Millimetre => 1.0,
+            LengthUnit::Metre => 1000.0,
+            LengthUnit::Inch => 25.4,
+        }
+    }
+}
+
+/// Unit of a force column.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ForceUnit {
+    /// Newtons (czid's unit).
+    #[default]
+    N,
+    /// Kilonewtons.
+    #[serde(rename = "kN")]
+    KiloNewton,
+    /// Pounds-force.
+    #[serde(rename = "lbf")]
+    PoundForce,
+}
+
+impl ForceUnit {
+    /// Factor to newtons.
+    pub fn to_newton(self) -> f64 {
+        match self {
+            ForceUnit::N => 1.0,
+            ForceUnit::KiloNewton => 1000.0,
+            ForceUnit::PoundForce => 4.448_221_615_260_5,
+        }
+    }
+}
+
+/// What a crack column holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CrackMeasure {
+    /// Crack length from the load line; its first value is a0, so debonded length = value − a0.
+    #[default]
+    CrackLength,
+    /// Debonded length (crack growth) directly.
+    DebondedLength,
+}
+
+/// Where a test's data is and how to read it (the `[experiment]` table of a problem file).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentSpec {
+    /// CSV file, relative to the problem file.
+    pub file: PathBuf,
+    /// Column with the control displacement (e.g. load-line opening).
+    pub displacement: String,
+    /// Column with the load.
+    pub load: String,
+    /// Column with the crack or debonded length, if measured.
+    #[serde(default)]
+    pub crack: Option<String>,
+    /// What the crack column holds.
+    #[serde(default)]
+    pub crack_measure: CrackMeasure,
+    /// Unit of the displacement and crack columns.
+    #[serde(default)]
+    pub length_unit: LengthUnit,
+    /// Unit of the load column.
+    #[serde(default)]
+    pub force_unit: ForceUnit,
+    /// Only use rows with displacement in `[min, max]` (mm, after unit conversion).
+    #[serde(default)]
+    pub range: Option<[f64; 2]>,
+    /// Drop rows whose displacement does not exceed every earlier one (machine relaxation at the
+    /// end of a test, noise in a seating toe) instead of reporting them as an error.
+    #[serde(default)]
+    pub drop_non_increasing: bool,
+}
+
+/// A test's curves in N and mm.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Experiment {
+    /// Name (the file stem unless given).
+    pub name: String,
+    /// Load (N) against displacement (mm).
+    pub load: Curve,
+    /// Debonded length (mm) against displacement (mm), when measured.
+    pub debonded_length: Option<Curve>,
+    /// First value of a crack-length column (the initial crack length a0, mm), when given.
+    pub initial_crack: Option<f64>,
+}
+
+impl ExperimentSpec {
+    /// Reads and checks the data; `base` is the folder relative paths start from.
+    pub fn load(&self, base: &Path) -> Result<Experiment> {
+        let path = base.join(&self.file);
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(&path).map_err(|e| CzError::Io {
+            path: shown.clone(),
+            message: format!("{e} (paths in a problem file are relative to the problem file)"),
+        })?;
+        let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(text.as_bytes());
+        let header: Vec<String> = reader
+            .headers()
+            .map_err(|e| CzError::data(&shown, format!("cannot read the header row: {e}")))?
+            .iter()
+            .map(str::to_string)
+            .collect();
+        let find = |key: &str, name: &str| -> Result<usize> {
+            header.iter().position(|h| h == name).ok_or_else(|| {
+                CzError::data(
+                    &shown,
+                    format!("no column `{name}` (asked for by `{key}`); the columns are: {}", header.join(", ")),
+                )
+            })
+        };
+        let ix = find("displacement", &self.displacement)?;
+        let iy = find("load", &self.load)?;
+        let ic = self.crack.as_deref().map(|c| find("crack", c)).transpose()?;
+
+        let (lu, fu) = (self.length_unit.to_mm(), self.force_unit.to_newton());
+        let mut rows: Vec<Row> = Vec::new();
+        for (i, record) in reader.records().enumerate() {
+            let row = i + 2;
+            let record = record.map_err(|e| CzError::data(format!("{shown}, row {row}"), e.to_string()))?;
+            let cell = |col: usize| -> Result<f64> {
+                let raw = record.get(col).unwrap_or("");
+                let v: f64 = raw.parse().map_err(|_| {
+                    CzError::data(
+                        format!("{shown}, row {row}, column `{}`", header[col]),
+                        format!("`{raw}` is not a number"),
+                    )
+                })?;
+                if !v.is_finite() {
+                    return Err(CzError::data(
+                        format!("{shown}, row {row}, column `{}`", header[col]),
+                        format!("`{raw}` is not a finite number"),
+                    ));
+                }
+                Ok(v)
+            };
+            rows.push(Row {
+                line: row,
+                x: cell(ix)? * lu,
+                y: cell(iy)? * fu,
+                crack: ic.map(cell).transpose()?.map(|c| c * lu),
+            });
+        }
+        if rows.is_empty() {
+            return Err(CzError::data(&shown, "the file has a header but no data rows"));
+        }
+        let initial_crack = match self.crack_measure {
+            CrackMeasure::CrackLength => rows[0].crack,
+            CrackMeasure::DebondedLength => None,
+        };
+
+        // Rows keep their line numbers so errors point at the file, not at a filtered copy.
+        let mut kept = rows;
+        if let Some([lo, hi]) = self.range {
+            if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
+                return Err(CzError::config(
+                    format!("experiment `{}`", self.file.display()),
+                    format!("range [{lo}, {hi}] must have min < max"),
+                ));
+            }
+            kept.retain(|r| r.x >= lo && r.x <= hi);
+            if kept.is_empty() {
+                return Err(CzError::data(&shown, format!("no rows with displacement in the range [{lo}, {hi}] mm")));
+            }
+        }
+        let mut reach = f64::NEG_INFINITY;
+        let mut monotone = Vec::with_capacity(kept.len());
+        for r in kept {
+            if r.x > reach {
+                reach = r.x;
+                monotone.push(r);
+            } else if !self.drop_non_increasing {
+                return Err(CzError::data(
+                    format!("{shown}, row {}, column `{}`", r.line, self.displacement),
+                    format!(
+                        "displacement {} mm does not increase (an earlier row reached {reach} mm); \
+                         set `drop_non_increasing = true` to drop such rows, or limit `range`",
+                        r.x
+                    ),
+                ));
+            }
+        }
+        let x: Vec<f64> = monotone.iter().map(|r| r.x).collect();
+        let load = Curve::new(x.clone(), monotone.iter().map(|r| r.y).collect())?;
+        let debonded_length = match ic {
+            None => None,
+            Some(_) => {
+                let offset = initial_crack.unwrap_or(0.0);
+                Some(Curve::new(x, monotone.iter().map(|r| r.crack.unwrap_or(0.0) - offset).collect())?)
+            }
+        };
+        let name = self.file.file_stem().map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
+        Ok(Experiment { name, load, debonded_length, initial_crack })
+    }
+}
+
+/// One data row in czid units, with its line number in the file.
+struct Row {
+    line: usize,
+    x: f64,
+    y: f64,
+    crack: Option<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(file: &str) -> ExperimentSpec {
+        ExperimentSpec {
+            file: file.into(),
+            displacement: "Disp".into(),
+            load: "Force".into(),
+            crack: Some("CrackExt".into()),
+            crack_measure: CrackMeasure::CrackLength,
+            length_unit: LengthUnit::Millimetre,
+            force_unit: ForceUnit::N,
+            range: None,
+            drop_non_increasing: false,
+        }
+    }
+
+    fn write(name: &str, text: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("czid-data-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("t.csv"), text).unwrap();
+        dir
+    }
+
+    #[test]
+    fn reads_and_converts_crack_length_to_debonded_length() {
+        let dir = write("ok", "Disp,Force,CrackExt\n0,0,40\n1,10,40\n2,15,42.5\n");
+        let e = spec("t.csv").load(&dir).unwrap();
+        assert_eq!(e.initial_crack, Some(40.0));
+        assert_eq!(e.debonded_length.unwrap().y(), &[0.0, 0.0, 2.5]);
+        assert_eq!(e.load.y(), &[0.0, 10.0, 15.0]);
+    }
+
+    #[test]
+    fn converts_units() {
+        let dir = write("units", "Disp,Force,CrackExt\n0,0,1\n0.001,0.01,1\n");
+        let mut s = spec("t.csv");
+        s.length_unit = LengthUnit::Metre;
+        s.force_unit = ForceUnit::KiloNewton;
+        let e = s.load(&dir).unwrap();
+        assert_eq!(e.load.x(), &[0.0, 1.0]);
+        assert_eq!(e.load.y(), &[0.0, 10.0]);
+    }
+
+    #[test]
+    fn each_bad_input_names_what_and_where() {
+        let cases = [
+            ("missing-col", "Disp,Load,CrackExt\n0,0,1\n", "no column `Force`"),
+            ("nonnum", "Disp,Force,CrackExt\n0,0,1\n1,abc,1\n", "row 3, column `Force`"),
+            ("nan", "Disp,Force,CrackExt\n0,0,1\n1,NaN,1\n", "not a finite number"),
+            ("empty", "Disp,Force,CrackExt\n", "no data rows"),
+            ("decreasing", "Disp,Force,CrackExt\n0,0,1\n2,1,1\n1,1,1\n", "row 4, column `Disp`"),
+        ];
+        for (name, text, expect) in cases {
+            let dir = write(name, text);
+            let e = spec("t.csv").load(&dir).unwrap_err().to_string();
+            assert!(e.contains(expect), "{name}: {e}");
+            assert!(e.contains("t.csv"), "{name} must name the file: {e}");
+        }
+        let e = spec("absent.csv").load(Path::new("/nonexistent")).unwrap_err().to_string();
+        assert!(e.contains("absent.csv"), "{e}");
+    }
+
+    #[test]
+    fn non_increasing_rows_can_be_dropped() {
+        let dir = write("drop", "Disp,Force,CrackExt\n0,0,1\n2,1,1\n1,1,1\n3,2,1\n");
+        let mut s = spec("t.csv");
+        s.drop_non_increasing = true;
+        assert_eq!(s.load(&dir).unwrap().load.x(), &[0.0, 2.0, 3.0]);
+    }
+
+    #[test]
+    fn reads_the_bundled_real_dcb_data() {
+        let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/hartlen-dcb-enf");
+        // DCB-03's opening increases throughout, so no row is dropped.
+        let e = spec("DCB-03_Toughness.csv").load(&base).unwrap();
+        assert_eq!(e.initial_crack, Some(25.391));
+        // Documented in the data README: peak 91.4 N at 6.1 mm, final crack 79.3 mm.
+        let peak = e.load.y().iter().cloned().fold(0.0, f64::max);
+        assert!((peak - 91.4).abs() < 0.1, "peak {peak}");
+        let growth = *e.debonded_length.unwrap().y().last().unwrap();
+        assert!((growth + 25.391 - 79.3).abs() < 0.1, "final crack {}", growth + 25.391);
+    }
+}
