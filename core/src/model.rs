@@ -25,10 +25,19 @@ impl std::error::Error for SimulationFailure {}
 ///
 /// The model owns its geometry, materials, loading and switchable physical effects; the law is
 /// passed per run so that an identification can try thousands of laws on one model (which may
-/// cache its mesh and symbolic factorisation across runs).
+/// cache its mesh and symbolic factorisation across runs, in fields marked `#[serde(skip)]`).
+///
+/// Like laws, models are registered with `typetag`, so a problem file names one by
+/// `type = "..."` and users add their own with `#[typetag::serde(name = "my_test")]`.
+#[typetag::serde(tag = "type")]
 pub trait ForwardModel: Send + Sync {
     /// Short name, e.g. `"dcb"`.
     fn name(&self) -> &str;
+
+    /// Checks the configuration; returns an error naming the first invalid field.
+    fn validate(&self) -> crate::error::Result<()> {
+        Ok(())
+    }
 
     /// Runs the test with `law`; returns one row per converged step with at least the columns
     /// of [`crate::columns`] that the model measures.
