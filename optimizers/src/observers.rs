@@ -1,0 +1,109 @@
+//! Observers: a terminal progress bar, a history CSV, and a fan-out to several observers.
+
+use czid_core::{CzError, Observer, Progress, Result, Snapshot};
+use std::path::Path;
+
+/// Sends every call to each of its observers; stops when any of them asks to.
+#[derive(Default)]
+pub struct Observers<'a>(pub Vec<&'a mut dyn Observer>);
+
+impl Observer for Observers<'_> {
+    fn observe(&mut self, progress: &Progress<'_>) -> bool {
+        // Every observer sees every iteration, even after one asked to stop.
+        self.0.iter_mut().fold(true, |go, o| o.observe(progress) && go)
+    }
+
+    fn checkpoint(&mut self, progress: &Progress<'_>, state: &dyn Snapshot) -> Result<()> {
+        self.0.iter_mut().try_for_each(|o| o.checkpoint(progress, state))
+    }
+}
+
+/// A terminal progress bar over the evaluation budget, showing the best value.
+pub struct ProgressBar {
+    bar: indicatif::ProgressBar,
+}
+
+impl ProgressBar {
+    /// A bar for a budget of `evaluations`.
+    pub fn new(evaluations: usize) -> Self {
+        let bar = indicatif::ProgressBar::new(evaluations as u64);
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} evals  {msg}")
+        {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        ProgressBar { bar }
+    }
+
+    /// A bar drawing nowhere (for tests and non-interactive runs).
+    pub fn hidden(evaluations: usize) -> Self {
+        let bar = Self::new(evaluations);
+        bar.bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+        bar
+    }
+
+    /// Clears the bar.
+    pub fn finish(&self) {
+        self.bar.finish();
+    }
+}
+
+impl Observer for ProgressBar {
+    fn observe(&mut self, p: &Progress<'_>) -> bool {
+        self.bar.set_position(p.evaluations as u64);
+        self.bar.set_message(format!("best {:.6e}  failed {}", p.best_value, p.failures));
+        true
+    }
+}
+
+/// Writes one CSV row per iteration: `iteration, evaluations, failures, best_value, x0, x1, …`.
+/// A write error stops the run and is returned by [`CsvHistory::finish`].
+pub struct CsvHistory {
+    writer: csv::Writer<std::fs::File>,
+    header: bool,
+    error: Option<CzError>,
+    path: String,
+}
+
+impl CsvHistory {
+    /// Creates (or truncates) `path`.
+    pub fn create(path: &Path) -> Result<Self> {
+        let writer = csv::Writer::from_path(path)
+            .map_err(|e| CzError::Io { path: path.display().to_string(), message: e.to_string() })?;
+        Ok(CsvHistory { writer, header: false, error: None, path: path.display().to_string() })
+    }
+
+    /// Flushes the file; returns the first write error, if any.
+    pub fn finish(mut self) -> Result<()> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        self.writer.flush().map_err(|e| CzError::Io { path: self.path.clone(), message: e.to_string() })
+    }
+
+    fn write(&mut self, p: &Progress<'_>) -> std::result::Result<(), csv::Error> {
+        if !self.header {
+            let mut h = vec!["iteration".to_string(), "evaluations".into(), "failures".into(), "best_value".into()];
+            h.extend((0..p.best_x.len()).map(|i| format!("x{i}")));
+            self.writer.write_record(&h)?;
+            self.header = true;
+        }
+        let mut row = vec![p.iteration.to_string(), p.evaluations.to_string(), p.failures.to_string()];
+        row.push(p.best_value.to_string());
+        row.extend(p.best_x.iter().map(|v| v.to_string()));
+        self.writer.write_record(&row)
+    }
+}
+
+impl Observer for CsvHistory {
+    fn observe(&mut self, p: &Progress<'_>) -> bool {
+        if self.error.is_some() {
+            return false;
+        }
+        if let Err(e) = self.write(p) {
+            self.error = Some(CzError::Io { path: self.path.clone(), message: e.to_string() });
+            return false;
+        }
+        true
+    }
+}
