@@ -30,7 +30,7 @@ impl std::error::Error for SimulationFailure {}
 /// Like laws, models are registered with `typetag`, so a problem file names one by
 /// `type = "..."` and users add their own with `#[typetag::serde(name = "my_test")]`.
 #[typetag::serde(tag = "type")]
-pub trait ForwardModel: Send + Sync {
+pub trait ForwardModel: Send + Sync + std::fmt::Debug {
     /// Short name, e.g. `"dcb"`.
     fn name(&self) -> &str;
 

@@ -128,10 +128,11 @@ impl CompositeObjective {
     }
 
     /// Chooses α so that every term contributes equally at `record` (the initial guess) and
-    /// `f = 1` there: α_i = 1 / (m ||φ_i||²). Terms that already fit exactly keep α_i = 1.
+    /// `f = 1` there: α_i = 1 / (m ||φ_i||²), m the number of terms with a misfit. Terms that
+    /// already fit exactly keep α_i = 1.
     pub fn balance_at(&mut self, record: &Record) -> Result<()> {
-        let m = self.terms.len() as f64;
         let parts = self.evaluate(record)?.terms;
+        let m = parts.iter().filter(|&&s| s > 0.0).count().max(1) as f64;
         for (t, s) in self.terms.iter_mut().zip(parts) {
             t.weight = if s > 0.0 { 1.0 / (m * s) } else { 1.0 };
         }

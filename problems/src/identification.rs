@@ -1,0 +1,255 @@
+//! An identification problem: a shared cohesive law, one forward model per experiment, the
+//! parameters to identify, and the composite objective, presented to optimizers as a
+//! [`Problem`] on the unit cube.
+
+use czid_core::{
+    columns, CohesiveLaw, ColumnResponse, CompositeObjective, CzError, Evaluation, ForwardModel, ObjectiveTerm,
+    ParameterSpace, Problem, Record, Result,
+};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+use crate::data::Experiment;
+
+/// What is simulated: one law shared by every experiment's forward model.
+///
+/// Parameter paths point into this structure: `law.<field>` for the law, and
+/// `models.<experiment>.<field>` for an experiment's model.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct Setup {
+    /// The cohesive law being identified.
+    pub law: Box<dyn CohesiveLaw>,
+    /// Forward model per experiment name.
+    pub models: BTreeMap<String, Box<dyn ForwardModel>>,
+}
+
+impl Setup {
+    /// Validates the law and every model.
+    pub fn validate(&self) -> Result<()> {
+        self.law.validate()?;
+        self.models.values().try_for_each(|m| m.validate())
+    }
+
+    /// A deep copy (through serde, as laws and models are trait objects).
+    pub fn duplicate(&self) -> Result<Setup> {
+        let v = serde_json::to_value(self).map_err(|e| CzError::config("setup", e.to_string()))?;
+        serde_json::from_value(v).map_err(|e| CzError::config("setup", e.to_string()))
+    }
+}
+
+/// Which responses an experiment contributes to the objective.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Term {
+    /// Load against displacement (φ_F).
+    Load,
+    /// Debonded length against displacement (φ_L).
+    DebondedLength,
+}
+
+impl Term {
+    /// Short name used in reports: `F` or `L`, as in the paper.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Term::Load => "F",
+            Term::DebondedLength => "L",
+        }
+    }
+}
+
+/// One experiment's data and objective.
+#[derive(Debug)]
+struct Fit {
+    name: String,
+    objective: CompositeObjective,
+    kinds: Vec<Term>,
+}
+
+/// The result of simulating one candidate.
+#[derive(Debug)]
+pub struct Outcome {
+    /// Objective value and parts.
+    pub evaluation: Evaluation,
+    /// Simulation record per experiment (possibly partial when a run failed part way).
+    pub records: BTreeMap<String, Record>,
+    /// Messages of runs that failed part way.
+    pub failures: Vec<String>,
+}
+
+/// An identification problem over the unit cube.
+#[derive(Debug)]
+pub struct Identification {
+    setup: Setup,
+    space: ParameterSpace,
+    fits: Vec<Fit>,
+}
+
+impl Identification {
+    /// Builds the problem. Each experiment compares its load curve and, when it has one and
+    /// `use_debonded_length` is set, its debonded-length curve; weights start at 1.
+    pub fn new(
+        setup: Setup,
+        space: ParameterSpace,
+        experiments: &[Experiment],
+        use_debonded_length: bool,
+    ) -> Result<Self> {
+        setup.validate()?;
+        let mut fits = Vec::new();
+        for e in experiments {
+            if !setup.models.contains_key(&e.name) {
+                return Err(CzError::config(
+                    format!("experiment `{}`", e.name),
+                    "has no forward model (each experiment needs a `model` table)",
+                ));
+            }
+            let mut terms = vec![ObjectiveTerm {
+                name: format!("F:{}", e.name),
+                response: Box::new(ColumnResponse::new(columns::DISPLACEMENT, columns::LOAD)),
+                data: e.load.clone(),
+                weight: 1.0,
+            }];
+            let mut kinds = vec![Term::Load];
+            if let (true, Some(l)) = (use_debonded_length, &e.debonded_length) {
+                if l.norm() > 0.0 {
+                    terms.push(ObjectiveTerm {
+                        name: format!("L:{}", e.name),
+                        response: Box::new(ColumnResponse::new(columns::DISPLACEMENT, columns::DEBONDED_LENGTH)),
+                        data: l.clone(),
+                        weight: 1.0,
+                    });
+                    kinds.push(Term::DebondedLength);
+                }
+            }
+            fits.push(Fit { name: e.name.clone(), objective: CompositeObjective::new(terms)?, kinds });
+        }
+        // Fail early, with the path named, if a parameter does not exist in the setup.
+        space.read(&setup)?;
+        Ok(Identification { setup, space, fits })
+    }
+
+    /// The parameter space.
+    pub fn space(&self) -> &ParameterSpace {
+        &self.space
+    }
+
+    /// The base setup (initial values).
+    pub fn setup(&self) -> &Setup {
+        &self.setup
+    }
+
+    /// Initial values of the parameters, read from the setup.
+    pub fn initial(&self) -> Result<Vec<f64>> {
+        self.space.read(&self.setup)
+    }
+
+    /// Term kinds present, in the order [`Evaluation::objectives`] reports them.
+    pub fn term_kinds(&self) -> Vec<Term> {
+        let mut kinds = vec![Term::Load];
+        if self.fits.iter().any(|f| f.kinds.contains(&Term::DebondedLength)) {
+            kinds.push(Term::DebondedLength);
+        }
+        kinds
+    }
+
+    /// Sets the weights so that, at the initial values, every term of every experiment contributes
+    /// equally and the objective is 1 (the paper's choice of α).
+    pub fn balance_weights(&mut self) -> Result<()> {
+        let x0 = self.initial()?;
+        let outcome = self.simulate(&x0)?;
+        let parts: Vec<Vec<f64>> = self
+            .fits
+            .iter()
+            .map(|fit| Ok(fit.objective.evaluate(&outcome.records[&fit.name])?.terms))
+            .collect::<Result<_>>()?;
+        // Terms that already fit exactly cannot be balanced; they keep α = 1 and do not count.
+        let m = parts.iter().flatten().filter(|&&s| s > 0.0).count().max(1) as f64;
+        for (fit, parts) in self.fits.iter_mut().zip(parts) {
+            let w: Vec<f64> = parts.iter().map(|&s| if s > 0.0 { 1.0 / (m * s) } else { 1.0 }).collect();
+            fit.objective.set_weights(&w)?;
+        }
+        Ok(())
+    }
+
+    /// Sets the weights of the load and debonded-length terms (α_F, α_L) for every experiment.
+    pub fn set_weights(&mut self, alpha_f: f64, alpha_l: f64) -> Result<()> {
+        for fit in &mut self.fits {
+            let w: Vec<f64> = fit.kinds.iter().map(|k| if *k == Term::Load { alpha_f } else { alpha_l }).collect();
+            fit.objective.set_weights(&w)?;
+        }
+        Ok(())
+    }
+
+    /// Current weights per experiment and term, e.g. `("F:dcb", 0.8)`.
+    pub fn weights(&self) -> Vec<(String, f64)> {
+        self.fits.iter().flat_map(|f| f.objective.terms().iter().map(|t| (t.name.clone(), t.weight))).collect()
+    }
+
+    /// The setup with physical parameter values `x` written in.
+    pub fn configure(&self, x: &[f64]) -> Result<Setup> {
+        let setup: Setup = self.space.apply(&self.setup, x)?;
+        setup.validate()?;
+        Ok(setup)
+    }
+
+    /// Simulates every experiment at physical values `x` and evaluates the objective.
+    ///
+    /// A run that fails part way is scored on its converged steps (the last value held), so the
+    /// optimizer sees a large but finite value; a run with fewer than two steps is an error.
+    pub fn simulate(&self, x: &[f64]) -> Result<Outcome> {
+        let setup = self.configure(x)?;
+        let kinds = self.term_kinds();
+        let mut objectives = vec![0.0; kinds.len()];
+        let mut residuals = Vec::new();
+        let mut records = BTreeMap::new();
+        let mut failures = Vec::new();
+        let mut value = 0.0;
+        for fit in &self.fits {
+            let model = &setup.models[&fit.name];
+            let record = match model.simulate(setup.law.as_ref()) {
+                Ok(r) => r,
+                Err(f) if f.partial.rows() >= 2 => {
+                    failures.push(format!("{}: {}", fit.name, f));
+                    f.partial
+                }
+                Err(f) => return Err(CzError::Simulation(format!("{}: {}", fit.name, f))),
+            };
+            let v = fit.objective.evaluate(&record)?;
+            for ((kind, part), term) in fit.kinds.iter().zip(&v.terms).zip(fit.objective.terms()) {
+                let slot = kinds.iter().position(|k| k == kind).expect("kinds cover every term");
+                objectives[slot] += term.weight * part;
+            }
+            value += v.value;
+            residuals.extend(fit.objective.residuals(&record)?);
+            records.insert(fit.name.clone(), record);
+        }
+        Ok(Outcome { evaluation: Evaluation { value, objectives, residuals }, records, failures })
+    }
+
+    /// Unweighted `||φ||²` per experiment and term, e.g. `("F:dcb", 1.2e-4)`.
+    pub fn term_values(&self, outcome: &Outcome) -> Result<Vec<(String, f64)>> {
+        let mut out = Vec::new();
+        for fit in &self.fits {
+            let v = fit.objective.evaluate(&outcome.records[&fit.name])?;
+            out.extend(fit.objective.terms().iter().zip(v.terms).map(|(t, s)| (t.name.clone(), s)));
+        }
+        Ok(out)
+    }
+}
+
+impl Problem for Identification {
+    fn dim(&self) -> usize {
+        self.space.dim()
+    }
+
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        vec![(0.0, 1.0); self.space.dim()]
+    }
+
+    fn evaluate(&self, u: &[f64]) -> Result<Evaluation> {
+        let x = self.space.from_unit(u);
+        Ok(self.simulate(&x)?.evaluation)
+    }
+
+    fn objectives(&self) -> usize {
+        self.term_kinds().len()
+    }
+}

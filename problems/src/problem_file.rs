@@ -1,0 +1,245 @@
+//! Problem files: a TOML description of an identification.
+//!
+//! ```toml
+//! # Units: N, mm, MPa.
+//! [law]                       # the cohesive law and its initial values
+//! type = "st_czm"
+//! # ... the law's parameters
+//!
+//! [[experiment]]              # one or more tests sharing the law
+//! name = "dcb"
+//! [experiment.data]           # see `ExperimentSpec`
+//! file = "dcb.csv"            # relative to this file
+//! displacement = "opening_mm"
+//! load = "load_N"
+//! crack = "debonded_mm"
+//! crack_measure = "debonded_length"
+//! [experiment.model]          # the forward model of this test
+//! type = "dcb"
+//! # ... geometry, elastic constants, effects
+//!
+//! [[parameter]]               # what is identified
+//! path = "law.strength_n"     # `law.<key>` or `models.<experiment>.<key>`
+//! unit = "MPa"
+//! lower = 5.0
+//! upper = 60.0
+//! scale = "linear"            # or "log"
+//!
+//! [objective]
+//! debonded_length = true      # fit the debonded length too (when the data has it)
+//! weights = "balanced"        # or { load = 1.0, debonded_length = 0.5 }
+//!
+//! [optimizer]
+//! type = "miga"
+//! seed = 1
+//! budget = 20000              # objective evaluations
+//! [optimizer.settings]        # the optimizer's own settings
+//! ```
+
+use crate::data::{Experiment, ExperimentSpec};
+use crate::identification::{Identification, Setup};
+use czid_core::{CohesiveLaw, CzError, ForwardModel, Parameter, ParameterSpace, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// One test: its data and its forward model.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentEntry {
+    /// Name used in reports and parameter paths (default: the data file's stem).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Where the data is.
+    pub data: ExperimentSpec,
+    /// The simulated test.
+    pub model: Box<dyn ForwardModel>,
+}
+
+/// How the objective's terms are weighted.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Weights {
+    /// `"balanced"`: equal contributions at the initial guess (the paper's choice).
+    Named(String),
+    /// Explicit α for the load and debonded-length terms.
+    Explicit {
+        /// α_F.
+        load: f64,
+        /// α_L.
+        #[serde(default = "one")]
+        debonded_length: f64,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl Default for Weights {
+    fn default() -> Self {
+        Weights::Named("balanced".into())
+    }
+}
+
+/// The `[objective]` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectiveSpec {
+    /// Fit the debonded length as well as the load (when the data has it).
+    #[serde(default = "yes")]
+    pub debonded_length: bool,
+    /// Term weights.
+    #[serde(default)]
+    pub weights: Weights,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl Default for ObjectiveSpec {
+    fn default() -> Self {
+        ObjectiveSpec { debonded_length: true, weights: Weights::default() }
+    }
+}
+
+/// The `[optimizer]` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimizerSpec {
+    /// Registered name, e.g. `"miga"`, `"nsga2"`, `"nelder-mead"`, `"hybrid"`.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Random seed.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Objective evaluations allowed.
+    pub budget: usize,
+    /// Stop once the objective reaches this value.
+    #[serde(default)]
+    pub target: Option<f64>,
+    /// The optimizer's own settings (see the Optimizers chapter).
+    #[serde(default)]
+    pub settings: toml::Table,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+/// A whole problem file.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProblemFile {
+    /// The cohesive law with its initial values.
+    pub law: Box<dyn CohesiveLaw>,
+    /// The tests.
+    pub experiment: Vec<ExperimentEntry>,
+    /// The identified parameters.
+    #[serde(default)]
+    pub parameter: Vec<Parameter>,
+    /// Objective options.
+    #[serde(default)]
+    pub objective: ObjectiveSpec,
+    /// Optimizer choice.
+    pub optimizer: OptimizerSpec,
+}
+
+/// A problem file read from disk, with its data loaded.
+#[derive(Debug)]
+pub struct LoadedProblem {
+    /// Where it was read from.
+    pub path: PathBuf,
+    /// Its content.
+    pub file: ProblemFile,
+    /// The experiments' data, in file order.
+    pub experiments: Vec<Experiment>,
+}
+
+impl LoadedProblem {
+    /// Reads a problem file, checks it and loads its data. Errors name the file and, for syntax
+    /// and key errors, the line and column.
+    pub fn read(path: &Path) -> Result<Self> {
+        let shown = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses problem-file text; `path` locates relative data files and names errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        let shown = path.display().to_string();
+        let file: ProblemFile = toml::from_str(text).map_err(|e| CzError::config(&shown, e.to_string().trim_end()))?;
+        file.law.validate().map_err(|e| CzError::config(format!("{shown}, [law]"), e.to_string()))?;
+        if file.experiment.is_empty() {
+            return Err(CzError::config(&shown, "at least one [[experiment]] is needed"));
+        }
+        if file.optimizer.budget == 0 {
+            return Err(CzError::config(format!("{shown}, [optimizer]"), "budget must be at least 1 evaluation"));
+        }
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut experiments = Vec::new();
+        let mut names = Vec::new();
+        for (i, entry) in file.experiment.iter().enumerate() {
+            entry
+                .model
+                .validate()
+                .map_err(|e| CzError::config(format!("{shown}, experiment {}: model", i + 1), e.to_string()))?;
+            let mut data = entry.data.load(base)?;
+            if let Some(n) = &entry.name {
+                data.name = n.clone();
+            }
+            if names.contains(&data.name) {
+                return Err(CzError::config(
+                    &shown,
+                    format!("two experiments are named `{}`; give each a `name`", data.name),
+                ));
+            }
+            names.push(data.name.clone());
+            experiments.push(data);
+        }
+        ParameterSpace::new(file.parameter.clone()).map_err(|e| CzError::config(&shown, e.to_string()))?;
+        Ok(LoadedProblem { path: path.to_path_buf(), file, experiments })
+    }
+
+    /// The identification problem this file describes (weights set as the file asks).
+    pub fn identification(&self) -> Result<Identification> {
+        let shown = self.path.display().to_string();
+        let setup = self.setup()?;
+        let space = ParameterSpace::new(self.file.parameter.clone())?;
+        if space.dim() == 0 {
+            return Err(CzError::config(&shown, "no [[parameter]] to identify"));
+        }
+        let x0 = space.read(&setup).map_err(|e| CzError::config(&shown, e.to_string()))?;
+        space.check_within(&x0).map_err(|e| CzError::config(&shown, e.to_string()))?;
+        let mut id = Identification::new(setup, space, &self.experiments, self.file.objective.debonded_length)?;
+        match &self.file.objective.weights {
+            Weights::Named(n) if n == "balanced" => id.balance_weights()?,
+            Weights::Named(n) => {
+                return Err(CzError::config(
+                    format!("{shown}, [objective] weights"),
+                    format!("`{n}` is not a weighting; use \"balanced\" or {{ load = .., debonded_length = .. }}"),
+                ))
+            }
+            Weights::Explicit { load, debonded_length } => id.set_weights(*load, *debonded_length)?,
+        }
+        Ok(id)
+    }
+
+    /// The law and models with their initial values.
+    pub fn setup(&self) -> Result<Setup> {
+        // Trait objects are copied through serde; the file itself stays untouched.
+        let law: Box<dyn CohesiveLaw> = roundtrip(&self.file.law)?;
+        let mut models = BTreeMap::new();
+        for (entry, data) in self.file.experiment.iter().zip(&self.experiments) {
+            models.insert(data.name.clone(), roundtrip(&entry.model)?);
+        }
+        Ok(Setup { law, models })
+    }
+}
+
+fn roundtrip<T: Serialize + serde::de::DeserializeOwned>(v: &T) -> Result<T> {
+    let j = serde_json::to_value(v).map_err(|e| CzError::config("problem", e.to_string()))?;
+    serde_json::from_value(j).map_err(|e| CzError::config("problem", e.to_string()))
+}

@@ -1,0 +1,178 @@
+//! Problem files and identification problems, on a toy law and a toy model whose exact answer is
+//! known, and every bad-input case a user can make.
+
+use czid_core::{
+    columns, CohesiveLaw, CzError, ForwardModel, Gap, LawEval, LawState, ParameterInfo, Problem, Record,
+    SimulationFailure, Tangent, Traction,
+};
+use czid_problems::problem_file::LoadedProblem;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A linear spring that never damages.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Spring {
+    stiffness: f64,
+}
+
+#[typetag::serde(name = "toy_spring")]
+impl CohesiveLaw for Spring {
+    fn validate(&self) -> czid_core::Result<()> {
+        czid_core::error::require_positive("law toy_spring", "stiffness", self.stiffness)
+    }
+    fn evaluate(&self, gap: &Gap, previous: &LawState) -> LawEval {
+        LawEval {
+            traction: Traction::new(self.stiffness * gap[0], self.stiffness * gap[1]),
+            tangent: Tangent::identity() * self.stiffness,
+            state: *previous,
+        }
+    }
+    fn fracture_energy(&self) -> [f64; 2] {
+        [f64::INFINITY; 2]
+    }
+    fn initial_stiffness(&self) -> [f64; 2] {
+        [self.stiffness; 2]
+    }
+    fn strength(&self) -> [f64; 2] {
+        [f64::INFINITY; 2]
+    }
+    fn parameters(&self) -> Vec<ParameterInfo> {
+        vec![ParameterInfo { name: "stiffness", value: self.stiffness, unit: "MPa/mm", meaning: "spring stiffness" }]
+    }
+}
+
+/// A patch of interface of area `area` opened by the control displacement.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Patch {
+    area: f64,
+    max_opening: f64,
+}
+
+#[typetag::serde(name = "toy_patch")]
+impl ForwardModel for Patch {
+    fn name(&self) -> &str {
+        "toy_patch"
+    }
+    fn validate(&self) -> czid_core::Result<()> {
+        czid_core::error::require_positive("model toy_patch", "area", self.area)
+    }
+    fn simulate(&self, law: &dyn CohesiveLaw) -> Result<Record, SimulationFailure> {
+        let mut r =
+            Record::new(&[(columns::DISPLACEMENT, "mm"), (columns::LOAD, "N"), (columns::DEBONDED_LENGTH, "mm")]);
+        let mut state = law.initial_state();
+        for i in 0..=20 {
+            let d = self.max_opening * i as f64 / 20.0;
+            let e = law.evaluate(&Gap::new(d, 0.0), &state);
+            state = e.state;
+            r.push(&[d, self.area * e.traction[0], d]);
+        }
+        Ok(r)
+    }
+}
+
+fn problem_text(extra_param: &str) -> String {
+    format!(
+        r#"
+[law]
+type = "toy_spring"
+stiffness = 50.0
+
+[[experiment]]
+name = "patch"
+[experiment.data]
+file = "patch.csv"
+displacement = "d"
+load = "P"
+crack = "L"
+crack_measure = "debonded_length"
+[experiment.model]
+type = "toy_patch"
+area = 2.0
+max_opening = 1.0
+
+[[parameter]]
+path = "law.stiffness"
+unit = "MPa/mm"
+lower = 10.0
+upper = 200.0
+{extra_param}
+
+[optimizer]
+type = "miga"
+budget = 100
+"#
+    )
+}
+
+/// Data made by hand: P = 2 mm² × 80 MPa/mm × d, so the answer is stiffness = 80.
+fn setup_dir(name: &str, problem: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("czid-pf-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut csv = String::from("d,P,L\n");
+    for i in 0..=10 {
+        let d = i as f64 / 10.0;
+        csv.push_str(&format!("{d},{},{d}\n", 160.0 * d));
+    }
+    std::fs::write(dir.join("patch.csv"), csv).unwrap();
+    std::fs::write(dir.join("problem.toml"), problem).unwrap();
+    dir
+}
+
+fn read(dir: &Path) -> czid_core::Result<LoadedProblem> {
+    LoadedProblem::read(&dir.join("problem.toml"))
+}
+
+#[test]
+fn the_known_answer_has_zero_objective_and_others_do_not() {
+    let dir = setup_dir("known", &problem_text(""));
+    let p = read(&dir).unwrap();
+    let id = p.identification().unwrap();
+    // Balanced weights: f = 1 at the initial guess.
+    assert!((id.evaluate(&id.space().to_unit(&[50.0])).unwrap().value - 1.0).abs() < 1e-12);
+    let at_truth = id.simulate(&[80.0]).unwrap().evaluation;
+    assert!(at_truth.value < 1e-24, "{}", at_truth.value);
+    let off = id.simulate(&[90.0]).unwrap().evaluation;
+    assert!(off.value > 1e-3);
+    // The debonded-length term fits exactly whatever the stiffness, so the load carries all misfit.
+    assert_eq!(off.objectives.len(), 2);
+    assert!(off.objectives[1] < 1e-24 && off.objectives[0] > 1e-3);
+}
+
+#[test]
+fn bad_inputs_are_named() {
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("typo", problem_text("scal = \"log\""), "scal"),
+        (
+            "inverted",
+            problem_text("").replace("lower = 10.0\nupper = 200.0", "lower = 200.0\nupper = 10.0"),
+            "inverted",
+        ),
+        ("outside", problem_text("").replace("stiffness = 50.0", "stiffness = 500.0"), "within its bounds"),
+        ("unknown-law", problem_text("").replace("toy_spring\"\nstiffness", "no_such_law\"\nstiffness"), "no_such_law"),
+        ("unknown-model", problem_text("").replace("toy_patch", "no_such_model"), "no_such_model"),
+        ("bad-path", problem_text("").replace("law.stiffness", "law.stiffnes"), "stiffnes"),
+        ("negative", problem_text("").replace("area = 2.0", "area = -2.0"), "area"),
+        ("missing-file", problem_text("").replace("patch.csv", "absent.csv"), "absent.csv"),
+        ("missing-column", problem_text("").replace("load = \"P\"", "load = \"Q\""), "no column `Q`"),
+    ];
+    for (name, text, expect) in cases {
+        let dir = setup_dir(name, &text);
+        let err: CzError = match read(&dir) {
+            Err(e) => e,
+            Ok(p) => p.identification().expect_err(name),
+        };
+        let msg = err.to_string();
+        eprintln!("{name}: {msg}");
+        assert!(msg.contains(expect), "{name}: `{msg}` should mention `{expect}`");
+    }
+}
+
+#[test]
+fn syntax_errors_give_line_and_column() {
+    let dir = setup_dir("syntax", &problem_text("").replace("area = 2.0", "area = = 2.0"));
+    let msg = read(&dir).unwrap_err().to_string();
+    assert!(msg.contains("line") && msg.contains("column"), "{msg}");
+    assert!(msg.contains("problem.toml"), "{msg}");
+}
