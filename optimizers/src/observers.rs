@@ -10,7 +10,11 @@ pub struct Observers<'a>(pub Vec<&'a mut dyn Observer>);
 impl Observer for Observers<'_> {
     fn observe(&mut self, progress: &Progress<'_>) -> bool {
         // Every observer sees every iteration, even after one asked to stop.
-        self.0.iter_mut().fold(true, |go, o| o.observe(progress) && go)
+        let mut go = true;
+        for o in self.0.iter_mut() {
+            go &= o.observe(progress);
+        }
+        go
     }
 
     fn checkpoint(&mut self, progress: &Progress<'_>, state: &dyn Snapshot) -> Result<()> {

@@ -89,7 +89,8 @@ impl ArgminInv<Mat> for Mat {
         let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for col in 0..n {
             let piv = (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs())).unwrap_or(col);
-            if !(a[piv * n + col].abs() > 1e-14 * scale) {
+            // Also catches NaN pivots.
+            if a[piv * n + col].abs().partial_cmp(&(1e-14 * scale)) != Some(std::cmp::Ordering::Greater) {
                 return Err(Error::msg("singular normal matrix JᵀJ"));
             }
             for c in 0..n {

@@ -42,14 +42,15 @@ pub struct LocalSettings {
     pub start: Option<Vec<f64>>,
     /// Map from `Rⁿ` onto the box (default `sine`).
     pub transform: BoundTransform,
-    /// Convergence tolerance (default 1e-14): Nelder–Mead, standard deviation of the simplex
+    /// Convergence tolerance (default 1e-20, small on purpose: these methods polish and the
+    /// budget is their real limit; raise it to stop earlier): Nelder–Mead, standard deviation of the simplex
     /// values; L-BFGS, gradient norm; Gauss–Newton, change of `‖r‖`; Levenberg–Marquardt,
     /// gradient `‖Jᵀr‖∞` and relative step.
     pub tolerance: f64,
     /// Edge of Nelder–Mead's initial simplex in `z` (default 0.5; `z` is in radians for the
     /// sine map, whose period is 2π).
     pub initial_step: f64,
-    /// Relative finite-difference step: `h = fd_step · max(1, |z_i|)` (default 1e-6).
+    /// Relative finite-difference step: `h = fd_step · max(1, |z_i|)` (default 1e-7).
     pub fd_step: f64,
     /// Finite-difference scheme (default central).
     pub differences: Differences,
@@ -69,9 +70,9 @@ impl Default for LocalSettings {
         LocalSettings {
             start: None,
             transform: BoundTransform::Sine,
-            tolerance: 1e-14,
+            tolerance: 1e-20,
             initial_step: 0.5,
-            fd_step: 1e-6,
+            fd_step: 1e-7,
             differences: Differences::Central,
             memory: 7,
             restarts: 2,

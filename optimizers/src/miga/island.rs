@@ -88,7 +88,7 @@ fn mutate(genes: &mut [u64], ops: &Operators, rng: &mut ChaCha8Rng) {
     loop {
         let u = 1.0 - rng.random::<f64>(); // in (0, 1]
         let skip = (u.ln() / log_q).floor();
-        if !(skip < (ops.len_bits - pos) as f64) {
+        if skip >= (ops.len_bits - pos) as f64 {
             return;
         }
         pos += skip as usize;
