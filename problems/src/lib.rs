@@ -3,10 +3,16 @@
 //! * [`data`]: experimental curves from CSV, checked and converted to N and mm.
 //! * [`identification`]: a shared law, per-experiment forward models, parameters and the
 //!   composite objective as a [`czid_core::Problem`] on the unit cube.
+//! * [`identify`]: the `identify` and `simulate` workflows, writing results, fits and plots.
+//! * [`identifiability`]: standard errors, correlations and a verdict per identified parameter.
+//! * [`output`]: output folders that are never clobbered by accident, files written atomically.
 //! * [`plot`]: line plots (PNG/SVG) with a bundled font, written atomically.
 //! * [`problem_file`]: the TOML problem file (law, experiments, parameters, objective, optimizer).
 
 pub mod data;
+pub mod identifiability;
 pub mod identification;
+pub mod identify;
+pub mod output;
 pub mod plot;
 pub mod problem_file;

@@ -176,3 +176,29 @@ fn syntax_errors_give_line_and_column() {
     assert!(msg.contains("line") && msg.contains("column"), "{msg}");
     assert!(msg.contains("problem.toml"), "{msg}");
 }
+
+#[test]
+fn identify_recovers_the_known_answer_and_writes_results() {
+    use czid_problems::identify::{identify, RunOptions};
+    use czid_problems::output::OutputDir;
+    let dir = setup_dir("identify", &problem_text("").replace("budget = 100", "budget = 400"));
+    let p = read(&dir).unwrap();
+    let out = OutputDir::create(&dir.join("out"), false, false).unwrap();
+    let res = identify(&p, &RunOptions::default(), &out).unwrap();
+    let k = res.parameters["law.stiffness"].value;
+    assert!((k - 80.0).abs() < 0.8, "identified stiffness {k}, expected 80");
+    assert_eq!(res.parameters["law.stiffness"].verdict, "determined");
+    assert!(res.evaluations <= 400);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.file("result.json")).unwrap()).unwrap();
+    for key in ["parameters", "objective", "objective_terms", "evaluations", "wall_seconds"] {
+        assert!(json.get(key).is_some(), "result.json lacks `{key}`");
+    }
+    for f in ["history.csv", "fit.csv", "fit-load.png", "fit-debonded.png", "convergence.png"] {
+        assert!(out.file(f).exists(), "{f} missing");
+    }
+    // Same seed, same answer.
+    let out2 = OutputDir::create(&dir.join("out2"), false, false).unwrap();
+    let again = identify(&p, &RunOptions::default(), &out2).unwrap();
+    assert_eq!(again.parameters["law.stiffness"].value, k);
+}

@@ -1,0 +1,143 @@
+//! Which identified parameters the data actually determine.
+//!
+//! At the optimum, the Jacobian J of the weighted residual vector with respect to the parameters
+//! (unit-cube coordinates, central differences) gives the Gauss–Newton covariance
+//! `σ² (JᵀJ)⁻¹` with `σ² = ||r||² / (n − p)`. From it: standard errors, correlations, and a
+//! plain verdict per parameter. A parameter the responses do not depend on at all (e.g. the
+//! shear parameters of a symmetric DCB, whose interface never slips) has a zero Jacobian column:
+//! it is reported as not determined, never as identified.
+
+use crate::identification::Identification;
+use czid_core::{ParameterSpace, Result, Scale};
+use nalgebra::DMatrix;
+
+/// Step of the central differences, in unit-cube coordinates.
+const STEP: f64 = 1e-3;
+/// A column this much smaller than the largest is treated as zero sensitivity.
+const NEGLIGIBLE: f64 = 1e-6;
+/// Standard error (unit-cube coordinates) above which a parameter is not pinned down.
+const LOOSE: f64 = 0.25;
+/// Correlation above which two parameters are reported as traded against each other.
+const CORRELATED: f64 = 0.95;
+
+/// The verdict on one parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Verdict {
+    /// Determined by the data.
+    Determined,
+    /// Strongly correlated with another parameter (index, correlation).
+    CorrelatedWith(usize, f64),
+    /// The data do not constrain it.
+    NotDetermined,
+    /// At its lower bound (the optimum may lie beyond).
+    AtLowerBound,
+    /// At its upper bound.
+    AtUpperBound,
+}
+
+impl Verdict {
+    /// Plain words, naming the other parameter where relevant.
+    pub fn describe(&self, space: &ParameterSpace) -> String {
+        match self {
+            Verdict::Determined => "determined".into(),
+            Verdict::CorrelatedWith(k, r) => {
+                format!("correlated with {} (r = {r:.3})", space.parameters()[*k].path)
+            }
+            Verdict::NotDetermined => "not determined by these data".into(),
+            Verdict::AtLowerBound => "at its lower bound".into(),
+            Verdict::AtUpperBound => "at its upper bound".into(),
+        }
+    }
+}
+
+/// Identifiability at a point.
+#[derive(Clone, Debug)]
+pub struct Assessment {
+    /// Verdict per parameter.
+    pub verdicts: Vec<Verdict>,
+    /// Standard error per parameter in physical units (None when not determined).
+    pub standard_errors: Vec<Option<f64>>,
+    /// Correlation matrix (row-major, p × p); NaN where undefined.
+    pub correlations: Vec<f64>,
+    /// Singular values of J (descending).
+    pub singular_values: Vec<f64>,
+}
+
+/// Assesses the parameters at unit-cube point `u`.
+pub fn assess(id: &Identification, u: &[f64]) -> Result<Assessment> {
+    let p = u.len();
+    let r0 = id.simulate(&id.space().from_unit(u))?.evaluation.residuals;
+    let n = r0.len();
+    let mut jac = DMatrix::<f64>::zeros(n, p);
+    for j in 0..p {
+        let (lo, hi) = ((u[j] - STEP).max(0.0), (u[j] + STEP).min(1.0));
+        let eval = |v: f64| -> Result<Vec<f64>> {
+            let mut w = u.to_vec();
+            w[j] = v;
+            Ok(id.simulate(&id.space().from_unit(&w))?.evaluation.residuals)
+        };
+        let (rl, rh) = (eval(lo)?, eval(hi)?);
+        for i in 0..n {
+            jac[(i, j)] = (rh[i] - rl[i]) / (hi - lo);
+        }
+    }
+    let norms: Vec<f64> = (0..p).map(|j| jac.column(j).norm()).collect();
+    let largest = norms.iter().cloned().fold(0.0, f64::max);
+    let insensitive: Vec<bool> = norms.iter().map(|&s| s <= NEGLIGIBLE * largest || s == 0.0).collect();
+
+    let sigma2 = if n > p { r0.iter().map(|v| v * v).sum::<f64>() / (n - p) as f64 } else { f64::NAN };
+    let svd = jac.clone().svd(false, false);
+    let singular_values = svd.singular_values.iter().cloned().collect();
+    // Covariance over the sensitive parameters only: the insensitive ones would make JᵀJ singular.
+    let keep: Vec<usize> = (0..p).filter(|&j| !insensitive[j]).collect();
+    let mut cov = DMatrix::<f64>::from_element(p, p, f64::NAN);
+    if !keep.is_empty() {
+        let jk = DMatrix::from_fn(n, keep.len(), |i, a| jac[(i, keep[a])]);
+        if let Some(inv) = (jk.transpose() * &jk).try_inverse() {
+            for (a, &ja) in keep.iter().enumerate() {
+                for (b, &jb) in keep.iter().enumerate() {
+                    cov[(ja, jb)] = sigma2 * inv[(a, b)];
+                }
+            }
+        }
+    }
+    let mut correlations = vec![f64::NAN; p * p];
+    for a in 0..p {
+        for b in 0..p {
+            correlations[a * p + b] = cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt();
+        }
+    }
+    let params = id.space().parameters();
+    let mut verdicts = Vec::with_capacity(p);
+    let mut standard_errors = Vec::with_capacity(p);
+    for j in 0..p {
+        let se_u = cov[(j, j)].sqrt();
+        let verdict = if insensitive[j] || se_u > LOOSE {
+            Verdict::NotDetermined
+        } else if u[j] <= STEP {
+            Verdict::AtLowerBound
+        } else if u[j] >= 1.0 - STEP {
+            Verdict::AtUpperBound
+        } else {
+            let partner = (0..p)
+                .filter(|&k| k != j && correlations[j * p + k].abs() > CORRELATED)
+                .max_by(|&a, &b| correlations[j * p + a].abs().total_cmp(&correlations[j * p + b].abs()));
+            match partner {
+                Some(k) => Verdict::CorrelatedWith(k, correlations[j * p + k]),
+                None => Verdict::Determined,
+            }
+        };
+        let x = params[j].from_unit(u[j]);
+        let dx_du = match params[j].scale {
+            Scale::Linear => params[j].upper - params[j].lower,
+            Scale::Log => x * (params[j].upper / params[j].lower).ln(),
+        };
+        standard_errors.push(if verdict == Verdict::NotDetermined || !se_u.is_finite() {
+            None
+        } else {
+            Some(se_u * dx_du)
+        });
+        verdicts.push(verdict);
+    }
+    Ok(Assessment { verdicts, standard_errors, correlations, singular_values })
+}

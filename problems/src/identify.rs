@@ -1,0 +1,298 @@
+//! `identify`: run an optimizer on a problem file and write the identified parameters, fits,
+//! history and plots. `simulate`: run the forward models at the initial values.
+
+use crate::identifiability::{assess, Verdict};
+use crate::identification::{Identification, Outcome};
+use crate::output::OutputDir;
+use crate::plot::{Figure, Series};
+use crate::problem_file::LoadedProblem;
+use czid_core::{columns, Budget, CzError, Evaluation, Observer, OptimizationResult, Problem, Progress, Result};
+use czid_optimizers::checkpoint::CheckpointWriter;
+use czid_optimizers::observers::{CsvHistory, Observers, ProgressBar};
+use czid_optimizers::registry::{local_from_config, optimizer_from_config};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Command-line overrides and run options.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Optimizer name instead of the file's (its settings then take their defaults).
+    pub optimizer: Option<String>,
+    /// Seed instead of the file's.
+    pub seed: Option<u64>,
+    /// Evaluation budget instead of the file's.
+    pub budget: Option<usize>,
+    /// Draw a progress bar.
+    pub progress: bool,
+    /// Continue from `checkpoint.json` in the output folder.
+    pub resume: bool,
+    /// Set to true (e.g. by Ctrl-C) to stop after the current iteration, leaving a checkpoint.
+    pub stop: Option<Arc<AtomicBool>>,
+}
+
+/// One identified parameter in `result.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParameterResult {
+    /// Identified value.
+    pub value: f64,
+    /// Unit.
+    pub unit: String,
+    /// Initial value.
+    pub initial: f64,
+    /// Bounds.
+    pub bounds: [f64; 2],
+    /// Standard error from the Gauss–Newton covariance at the optimum (same unit), if defined.
+    pub standard_error: Option<f64>,
+    /// Plain verdict: determined, correlated with another, not determined, or at a bound.
+    pub verdict: String,
+}
+
+/// `result.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct IdentifyResult {
+    /// The problem file.
+    pub problem: String,
+    /// True when the run was interrupted: the values are the best found so far.
+    pub partial: bool,
+    /// Optimizer name.
+    pub optimizer: String,
+    /// Seed.
+    pub seed: u64,
+    /// Evaluation budget.
+    pub budget: usize,
+    /// Identified parameters by path.
+    pub parameters: BTreeMap<String, ParameterResult>,
+    /// Objective f at the identified parameters.
+    pub objective: f64,
+    /// Weighted parts of f: `F` (load) and `L` (debonded length).
+    pub objective_terms: BTreeMap<String, f64>,
+    /// Unweighted ||φ||² per experiment and term.
+    pub misfit: BTreeMap<String, f64>,
+    /// Weights α per experiment and term.
+    pub weights: BTreeMap<String, f64>,
+    /// Objective evaluations spent.
+    pub evaluations: usize,
+    /// Evaluations whose simulation failed.
+    pub failed_evaluations: usize,
+    /// Wall time of the optimisation (s).
+    pub wall_seconds: f64,
+    /// Share of the wall time spent in forward simulations, summed over threads (may exceed 1 with
+    /// parallel evaluation).
+    pub forward_share: f64,
+    /// Warnings worth reading.
+    pub warnings: Vec<String>,
+}
+
+/// Counts evaluations and the time spent in them.
+struct Timed<'a> {
+    inner: &'a Identification,
+    nanos: AtomicU64,
+    calls: AtomicUsize,
+}
+
+impl Problem for Timed<'_> {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        self.inner.bounds()
+    }
+    fn evaluate(&self, x: &[f64]) -> Result<Evaluation> {
+        let t = Instant::now();
+        let r = self.inner.evaluate(x);
+        self.nanos.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        r
+    }
+    fn objectives(&self) -> usize {
+        self.inner.objectives()
+    }
+}
+
+/// Stops the run when the flag is set.
+struct StopFlag(Option<Arc<AtomicBool>>, bool);
+
+impl Observer for StopFlag {
+    fn observe(&mut self, _: &Progress<'_>) -> bool {
+        let stop = self.0.as_ref().is_some_and(|f| f.load(Ordering::SeqCst));
+        self.1 |= stop;
+        !stop
+    }
+}
+
+const LOCAL: &[&str] = &["nelder-mead", "lbfgs", "gauss-newton", "levenberg-marquardt", "lm"];
+
+/// Runs the identification described by `problem`, writing into `out`.
+pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> Result<IdentifyResult> {
+    let id = problem.identification()?;
+    let spec = &problem.file.optimizer;
+    let name = opts.optimizer.clone().unwrap_or_else(|| spec.kind.clone());
+    // Settings in the file belong to the file's optimizer; another one starts from its defaults.
+    let settings = if name == spec.kind {
+        toml::Value::Table(spec.settings.clone())
+    } else {
+        toml::Value::Table(Default::default())
+    };
+    let seed = opts.seed.unwrap_or(spec.seed);
+    let budget = Budget { evaluations: opts.budget.unwrap_or(spec.budget), target: spec.target };
+    if budget.evaluations == 0 {
+        return Err(CzError::config("--budget", "must be at least 1 evaluation"));
+    }
+    let x0 = id.initial()?;
+    let u0 = id.space().to_unit(&x0);
+
+    let timed = Timed { inner: &id, nanos: AtomicU64::new(0), calls: AtomicUsize::new(0) };
+    let mut history = CsvHistory::create(&out.file("history.csv"))?;
+    let mut checkpoint = CheckpointWriter::new(out.file("checkpoint.json"), 1)?;
+    let mut bar =
+        if opts.progress { ProgressBar::new(budget.evaluations) } else { ProgressBar::hidden(budget.evaluations) };
+    let mut stop = StopFlag(opts.stop.clone(), false);
+    let start = Instant::now();
+    let result: OptimizationResult = {
+        let mut observers = Observers(vec![&mut history, &mut checkpoint, &mut bar, &mut stop]);
+        if LOCAL.contains(&name.as_str()) {
+            let local = local_from_config(&name, &settings)?;
+            local.minimize_from(&timed, &budget, &u0, &mut observers)?
+        } else {
+            let optimizer = optimizer_from_config(&name, &settings)?;
+            if opts.resume {
+                let state = czid_optimizers::checkpoint::read_checkpoint(&out.file("checkpoint.json"))?;
+                optimizer.resume(&timed, &budget, &state, &mut observers)?
+            } else {
+                optimizer.minimize(&timed, &budget, seed, &mut observers)?
+            }
+        }
+    };
+    let wall = start.elapsed().as_secs_f64();
+    bar.finish();
+    history.finish()?;
+    let partial = stop.1;
+
+    let x = id.space().from_unit(&result.best_x);
+    let outcome = id.simulate(&x)?;
+    let mut warnings: Vec<String> = outcome.failures.clone();
+    let assessment = assess(&id, &result.best_x)?;
+    let mut parameters = BTreeMap::new();
+    for (i, p) in id.space().parameters().iter().enumerate() {
+        let verdict = &assessment.verdicts[i];
+        if matches!(verdict, Verdict::NotDetermined) {
+            warnings.push(format!("`{}` is not determined by these data: its value is arbitrary", p.path));
+        }
+        parameters.insert(
+            p.path.clone(),
+            ParameterResult {
+                value: x[i],
+                unit: p.unit.clone(),
+                initial: x0[i],
+                bounds: [p.lower, p.upper],
+                standard_error: assessment.standard_errors[i],
+                verdict: verdict.describe(id.space()),
+            },
+        );
+    }
+    let kinds = id.term_kinds();
+    let objective_terms =
+        kinds.iter().zip(&outcome.evaluation.objectives).map(|(k, v)| (k.symbol().to_string(), *v)).collect();
+    let res = IdentifyResult {
+        problem: problem.path.display().to_string(),
+        partial,
+        optimizer: name,
+        seed,
+        budget: budget.evaluations,
+        parameters,
+        objective: outcome.evaluation.value,
+        objective_terms,
+        misfit: id.term_values(&outcome)?.into_iter().collect(),
+        weights: id.weights().into_iter().collect(),
+        evaluations: result.evaluations,
+        failed_evaluations: result.failures,
+        wall_seconds: wall,
+        forward_share: timed.nanos.load(Ordering::Relaxed) as f64 * 1e-9 / wall.max(1e-12),
+        warnings,
+    };
+    let json = serde_json::to_string_pretty(&res).map_err(|e| CzError::config("result", e.to_string()))?;
+    out.write(if partial { "result.partial.json" } else { "result.json" }, &json)?;
+    write_fits(problem, &outcome, out, "fit")?;
+    convergence_plot(&result, out)?;
+    Ok(res)
+}
+
+/// Runs every experiment's model at the initial values; writes `curves.csv` (or
+/// `curves-<experiment>.csv` when there are several) and plots against the data.
+pub fn simulate(problem: &LoadedProblem, out: &OutputDir) -> Result<Outcome> {
+    let id = Identification::new(
+        problem.setup()?,
+        czid_core::ParameterSpace::default(),
+        &problem.experiments,
+        problem.file.objective.debonded_length,
+    )?;
+    let outcome = id.simulate(&[])?;
+    write_fits(problem, &outcome, out, "curves")?;
+    Ok(outcome)
+}
+
+fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &OutputDir, stem: &str) -> Result<()> {
+    let several = outcome.records.len() > 1;
+    for e in &problem.experiments {
+        let record = &outcome.records[&e.name];
+        let suffix = if several { format!("-{}", e.name) } else { String::new() };
+        let wanted = [
+            columns::DISPLACEMENT,
+            columns::LOAD,
+            columns::DEBONDED_LENGTH,
+            columns::PROCESS_ZONE_LENGTH,
+            columns::CRACK_TIP,
+            columns::EXTERNAL_WORK,
+            columns::ELASTIC_ENERGY,
+            columns::DISSIPATED_ENERGY,
+        ];
+        let mut header = Vec::new();
+        let mut cols = Vec::new();
+        for c in wanted {
+            if let Ok(v) = record.column(c) {
+                header.push(format!("{c} ({})", record.unit(c).unwrap_or("-")));
+                cols.push(v.to_vec());
+            }
+        }
+        out.write_csv(&format!("{stem}{suffix}.csv"), &header, &cols)?;
+
+        let sim = record.curve(columns::DISPLACEMENT, columns::LOAD)?;
+        Figure::new(&format!("{}: load", e.name), "displacement (mm)", "load (N)")
+            .with(Series::points("test", e.load.x().to_vec(), e.load.y().to_vec()))
+            .with(Series::line("model", sim.x().to_vec(), sim.y().to_vec()))
+            .save(&out.file(&format!("{stem}{suffix}-load.png")))?;
+        if let (Some(l), Ok(sim)) = (&e.debonded_length, record.curve(columns::DISPLACEMENT, columns::DEBONDED_LENGTH))
+        {
+            Figure::new(&format!("{}: debonded length", e.name), "displacement (mm)", "debonded length (mm)")
+                .with(Series::points("test", l.x().to_vec(), l.y().to_vec()))
+                .with(Series::line("model", sim.x().to_vec(), sim.y().to_vec()))
+                .save(&out.file(&format!("{stem}{suffix}-debonded.png")))?;
+        }
+    }
+    Ok(())
+}
+
+fn convergence_plot(result: &OptimizationResult, out: &OutputDir) -> Result<()> {
+    // A staircase: the best value holds until the next improvement.
+    let mut x = Vec::new();
+    let mut y = Vec::new();
+    for (i, &(n, v)) in result.history.iter().enumerate() {
+        if i > 0 {
+            x.push(n as f64);
+            y.push(*y.last().expect("previous point"));
+        }
+        x.push(n as f64);
+        y.push(v);
+    }
+    if let Some(&last) = y.last() {
+        x.push(result.evaluations as f64);
+        y.push(last);
+    }
+    Figure::new("convergence", "evaluations", "best objective f")
+        .log_y()
+        .with(Series::line("best so far", x, y))
+        .save(&out.file("convergence.png"))
+}
