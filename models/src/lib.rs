@@ -3,4 +3,8 @@
 //! * [`laws`]: ST-CZM (Nairn & Aimene), bilinear mixed mode (Camanho–Dávila, BK), exponential
 //!   (Xu–Needleman) and a bridging (R-curve) law, all behind [`czid_core::CohesiveLaw`].
 
+pub mod beamtest;
+pub mod dcb;
+pub mod effects;
+pub mod fe;
 pub mod laws;

@@ -1,0 +1,204 @@
+//! Pieces shared by the beam test models (DCB, ENF): materials, mesh and control settings, and the
+//! conversion of engine rows into a [`Record`].
+
+use czid_core::error::{require_non_negative, require_positive};
+use czid_core::{columns, CzError, Record, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::fe::path::StepRow;
+
+/// Which 2D idealisation the adherends follow.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Plane {
+    /// Free to contract across the width: axial modulus E11 (narrow specimens; the default).
+    #[default]
+    Stress,
+    /// Restrained across the width: axial modulus E11 / (1 − ν13 ν31), ν31 = ν13 E22 / E11.
+    Strain,
+}
+
+/// Orthotropic adherend constants (MPa).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Axial (fibre-direction) Young's modulus E11 (MPa).
+    pub e11: f64,
+    /// Through-thickness Young's modulus E22 = E33 (MPa); used in plane strain and by reference
+    /// formulas (corrected beam theory), not by the beams themselves.
+    pub e22: f64,
+    /// Transverse shear modulus G13 (MPa), resisting the beams' shear deformation.
+    pub g13: f64,
+    /// Poisson's ratio ν13 across the width (only used in plane strain).
+    #[serde(default)]
+    pub nu13: f64,
+    /// Plane stress (default) or plane strain.
+    #[serde(default)]
+    pub plane: Plane,
+}
+
+impl Material {
+    /// Checks the constants.
+    pub fn validate(&self, owner: &str) -> Result<()> {
+        require_positive(owner, "material.e11", self.e11)?;
+        require_positive(owner, "material.e22", self.e22)?;
+        require_positive(owner, "material.g13", self.g13)?;
+        if !(self.nu13.is_finite() && (0.0..0.5).contains(&self.nu13)) {
+            return Err(CzError::invalid(owner, "material.nu13", self.nu13, "must lie in [0, 0.5)"));
+        }
+        Ok(())
+    }
+
+    /// Axial modulus seen by the beams (MPa).
+    pub fn axial_modulus(&self) -> f64 {
+        match self.plane {
+            Plane::Stress => self.e11,
+            Plane::Strain => self.e11 / (1.0 - self.nu13 * self.nu13 * self.e22 / self.e11),
+        }
+    }
+}
+
+/// Element sizes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MeshSettings {
+    /// Largest element along the bonded interface, where the crack can run (mm). The paper uses
+    /// 0.1 mm; the process zone should span at least ~5 elements.
+    pub interface_element: f64,
+    /// Largest element along the cracked arms (mm); they stay elastic, so they can be coarser.
+    pub arm_element: f64,
+}
+
+impl Default for MeshSettings {
+    fn default() -> Self {
+        MeshSettings { interface_element: 0.1, arm_element: 0.5 }
+    }
+}
+
+impl MeshSettings {
+    /// Checks the sizes.
+    pub fn validate(&self, owner: &str) -> Result<()> {
+        require_positive(owner, "mesh.interface_element", self.interface_element)?;
+        require_positive(owner, "mesh.arm_element", self.arm_element)
+    }
+}
+
+/// How far to load and how often to record.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlSettings {
+    /// Final applied displacement (mm); `None` chooses one from the geometry and the law's
+    /// toughness (see each model).
+    pub max_displacement: Option<f64>,
+    /// Number of equally spaced displacements at which a state is always recorded (more rows
+    /// appear where steps were refined).
+    pub output_points: usize,
+    /// Damage at or above which the interface counts as debonded.
+    pub damage_threshold: f64,
+    /// Newton iterations allowed per step before it is cut.
+    pub max_iterations: usize,
+    /// Relative residual tolerance.
+    pub tolerance: f64,
+}
+
+impl Default for ControlSettings {
+    fn default() -> Self {
+        ControlSettings {
+            max_displacement: None,
+            output_points: 100,
+            damage_threshold: 1.0 - 1e-9,
+            max_iterations: 12,
+            tolerance: 1e-9,
+        }
+    }
+}
+
+impl ControlSettings {
+    /// Checks the settings.
+    pub fn validate(&self, owner: &str) -> Result<()> {
+        if let Some(d) = self.max_displacement {
+            require_positive(owner, "control.max_displacement", d)?;
+        }
+        if self.output_points == 0 || self.output_points > 1_000_000 {
+            return Err(CzError::invalid(
+                owner,
+                "control.output_points",
+                self.output_points as f64,
+                "must be between 1 and 1e6",
+            ));
+        }
+        if !(self.damage_threshold > 0.0 && self.damage_threshold <= 1.0) {
+            return Err(CzError::invalid(
+                owner,
+                "control.damage_threshold",
+                self.damage_threshold,
+                "must lie in (0, 1]",
+            ));
+        }
+        if self.max_iterations == 0 {
+            return Err(CzError::invalid(owner, "control.max_iterations", 0.0, "must be at least 1"));
+        }
+        require_positive(owner, "control.tolerance", self.tolerance)
+    }
+}
+
+/// Standard columns of a beam test record.
+pub fn new_record() -> Record {
+    Record::new(&[
+        (columns::DISPLACEMENT, "mm"),
+        (columns::LOAD, "N"),
+        (columns::DEBONDED_LENGTH, "mm"),
+        (columns::PROCESS_ZONE_LENGTH, "mm"),
+        (columns::CRACK_TIP, "mm"),
+        (columns::EXTERNAL_WORK, "N·mm"),
+        (columns::ELASTIC_ENERGY, "N·mm"),
+        (columns::DISSIPATED_ENERGY, "N·mm"),
+    ])
+}
+
+/// How engine rows map to the specimen's record.
+#[derive(Clone, Copy, Debug)]
+pub struct RowScale {
+    /// Recorded displacement per unit of the control unknown.
+    pub displacement: f64,
+    /// Added to the recorded displacement (seating offset).
+    pub offset: f64,
+    /// Recorded load per unit reaction.
+    pub load: f64,
+    /// Whole-specimen energy per unit energy of the simulated part (2 for a half model).
+    pub energy: f64,
+}
+
+/// Converts engine rows to a record.
+pub fn to_record(rows: &[StepRow], s: &RowScale) -> Record {
+    let mut rec = new_record();
+    if s.offset > 0.0 {
+        // The seating toe: the load stays at zero until the offset is taken up.
+        let tip = rows.first().map_or(0.0, |r| r.crack.tip);
+        rec.push(&[0.0, 0.0, 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
+    }
+    for r in rows {
+        let p = s.load * r.reaction;
+        rec.push(&[
+            s.displacement * r.control + s.offset,
+            p,
+            r.crack.debonded,
+            r.crack.process_zone,
+            r.crack.tip,
+            s.energy * r.external_work,
+            s.energy * r.elastic_energy,
+            s.energy * r.dissipated_energy,
+        ]);
+    }
+    rec
+}
+
+/// Checks a length is positive.
+pub fn positive(owner: &str, name: &str, v: f64) -> Result<()> {
+    require_positive(owner, name, v)
+}
+
+/// Checks a value is not negative.
+pub fn non_negative(owner: &str, name: &str, v: f64) -> Result<()> {
+    require_non_negative(owner, name, v)
+}

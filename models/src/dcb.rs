@@ -1,0 +1,316 @@
+//! Double cantilever beam (DCB, mode I) on the beam/interface engine.
+//!
+//! The specimen runs from the load line (`x = 0`, where hinges pull the arms apart) to its far
+//! end (`x = length`); the arms are unbonded over `0 ≤ x < a0` and joined by the cohesive
+//! interface beyond. The applied displacement is the load-line opening `δ` (crosshead motion when
+//! a machine compliance is switched on) and the load is the hinge force `P`.
+//!
+//! * **Half model** (default): one arm above the symmetry plane. The opening is twice the arm's
+//!   load-point deflection, the interface gap `g_n = 2 w_surface`, `g_t = 0` by symmetry, and every
+//!   energy is doubled in the record. With small rotations the arm carries no axial force, so its
+//!   axial unknowns are dropped (exact, and it halves the band).
+//! * **Full model**: two arms, possibly of different thickness (`h_lower`); the lower hinge is
+//!   held, the upper hinge moves by `δ`; both hinges are held on the load line horizontally.
+//!
+//! ```
+//! use czid_core::{columns, ForwardModel};
+//! use czid_models::dcb::Dcb;
+//! # use czid_core::{CohesiveLaw, Gap, LawEval, LawState, ParameterInfo, Result};
+//! # #[derive(Debug, serde::Serialize, serde::Deserialize)] struct L;
+//! # #[typetag::serde(name = "dcb_doc_law")] impl CohesiveLaw for L {
+//! #   fn validate(&self) -> Result<()> { Ok(()) }
+//! #   fn evaluate(&self, g: &Gap, _p: &LawState) -> LawEval {
+//! #     LawEval { traction: g * 1e5, tangent: czid_core::Tangent::identity() * 1e5, state: LawState::default() } }
+//! #   fn fracture_energy(&self) -> [f64; 2] { [0.3, 0.6] }
+//! #   fn initial_stiffness(&self) -> [f64; 2] { [1e5, 1e5] }
+//! #   fn strength(&self) -> [f64; 2] { [60.0, 60.0] }
+//! #   fn parameters(&self) -> Vec<ParameterInfo> { vec![] } }
+//! let mut dcb = Dcb::paper();
+//! dcb.mesh.interface_element = 0.5;
+//! dcb.control.max_displacement = Some(0.5);
+//! dcb.control.output_points = 5;
+//! let record = dcb.simulate(&L).unwrap();
+//! let load = record.column(columns::LOAD).unwrap();
+//! assert!(load.last().unwrap() > &0.0);
+//! ```
+
+use czid_core::{CohesiveLaw, CzError, ForwardModel, Record, Result, SimulationFailure};
+use serde::{Deserialize, Serialize};
+
+use crate::beamtest::{self, ControlSettings, Material, MeshSettings, RowScale};
+use crate::effects::Effects;
+use crate::fe::mesh::{graded, NONE};
+use crate::fe::{
+    self, FeProblem, InterfacePoint, Layer, Mesh, NewtonSettings, PathSettings, PointKind, Section, Spring,
+};
+
+/// Half (symmetric) or full (two-arm) model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Symmetry {
+    /// One arm above a symmetry plane (equal arms only).
+    #[default]
+    Half,
+    /// Both arms and the interface between them.
+    Full,
+}
+
+/// DCB configuration. All lengths in mm, moduli in MPa.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Dcb {
+    /// Initial crack length from the load line to the crack front (mm).
+    pub a0: f64,
+    /// Specimen length from the load line to the far end (mm).
+    pub length: f64,
+    /// Width b (mm).
+    pub width: f64,
+    /// Arm thickness h (mm) (the upper arm in the full model).
+    pub h: f64,
+    /// Lower arm thickness (mm), full model only; `None`: equal arms.
+    #[serde(default)]
+    pub h_lower: Option<f64>,
+    /// Adherend constants.
+    pub material: Material,
+    /// Half (default) or full model.
+    #[serde(default)]
+    pub symmetry: Symmetry,
+    /// Element sizes.
+    #[serde(default)]
+    pub mesh: MeshSettings,
+    /// Loading and output; `control.max_displacement` is the final load-line opening (mm),
+    /// by default the opening at which beam theory puts the crack 60 % of the way to the far end.
+    #[serde(default)]
+    pub control: ControlSettings,
+    /// Optional physics (all off by default).
+    #[serde(default)]
+    pub effects: Effects,
+}
+
+const OWNER: &str = "model dcb";
+
+impl Dcb {
+    /// The DCB of Shi & Zhang (l = 180, b = 20, a0 = 50, 2h = 3.24 mm; E11 = 130, E22 = 6.5,
+    /// G13 = 2.7 GPa), plane stress, 0.1 mm interface elements.
+    pub fn paper() -> Self {
+        Dcb {
+            a0: 50.0,
+            length: 180.0,
+            width: 20.0,
+            h: 1.62,
+            h_lower: None,
+            material: Material { e11: 130_000.0, e22: 6_500.0, g13: 2_700.0, nu13: 0.26, plane: Default::default() },
+            symmetry: Symmetry::Half,
+            mesh: MeshSettings::default(),
+            control: ControlSettings::default(),
+            effects: Effects::default(),
+        }
+    }
+
+    /// Hartlen's specimen DCB-01 (b = 25, h = 2.7 per arm, L = 123, a0 = 37.64 mm; E_L = 19.3,
+    /// E_T = 6.11, G_LT = 2.288 GPa), loaded to 30 mm opening.
+    pub fn hartlen_dcb01() -> Self {
+        Dcb {
+            a0: 37.64,
+            length: 123.0,
+            width: 25.0,
+            h: 2.7,
+            h_lower: None,
+            material: Material { e11: 19_300.0, e22: 6_110.0, g13: 2_288.0, nu13: 0.0, plane: Default::default() },
+            symmetry: Symmetry::Half,
+            mesh: MeshSettings { interface_element: 0.2, arm_element: 1.0 },
+            control: ControlSettings { max_displacement: Some(30.0), ..Default::default() },
+            effects: Effects::default(),
+        }
+    }
+
+    /// Checks the configuration, naming the first invalid field.
+    pub fn validate(&self) -> Result<()> {
+        beamtest::positive(OWNER, "a0", self.a0)?;
+        beamtest::positive(OWNER, "length", self.length)?;
+        beamtest::positive(OWNER, "width", self.width)?;
+        beamtest::positive(OWNER, "h", self.h)?;
+        if let Some(hl) = self.h_lower {
+            beamtest::positive(OWNER, "h_lower", hl)?;
+            if self.symmetry == Symmetry::Half && hl != self.h {
+                return Err(CzError::invalid(OWNER, "h_lower", hl, "unequal arms need `symmetry = \"full\"`"));
+            }
+        }
+        self.material.validate(OWNER)?;
+        self.mesh.validate(OWNER)?;
+        self.control.validate(OWNER)?;
+        self.effects.validate(OWNER)?;
+        let a = self.effective_crack_length();
+        if !(a > 0.0 && a < self.length) {
+            return Err(CzError::invalid(
+                OWNER,
+                "a0",
+                self.a0,
+                format!(
+                    "the crack front a0 + effects.crack_length_offset = {a} must lie inside the specimen (0, {})",
+                    self.length
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Crack length the mesh uses: `a0 + effects.crack_length_offset` (mm).
+    pub fn effective_crack_length(&self) -> f64 {
+        self.a0 + self.effects.crack_length_offset
+    }
+
+    /// Final opening: the configured one, or the simple-beam-theory opening at which the crack
+    /// reaches 60 % of the bonded length, `δ = (2a²/3) √(b G_Ic / EI)` at `a = a0 + 0.6 (L − a0)`.
+    pub fn max_opening(&self, law: &dyn CohesiveLaw) -> f64 {
+        if let Some(d) = self.control.max_displacement {
+            return d;
+        }
+        let a = self.a0 + 0.6 * (self.length - self.a0);
+        let ei = self.section(self.h).ei();
+        let gc = law.fracture_energy()[0].max(1e-12);
+        2.0 * a * a / 3.0 * (self.width * gc / ei).sqrt()
+    }
+
+    fn section(&self, h: f64) -> Section {
+        Section { e: self.material.axial_modulus(), g: self.material.g13, b: self.width, h }
+    }
+
+    /// Builds the discrete problem (mesh built per run: it costs well under 1 % of a run, and
+    /// keeps the model plain data that any parameter change invalidates automatically).
+    pub fn problem(&self) -> Result<(FeProblem, RowScale)> {
+        self.validate()?;
+        let fx = &self.effects;
+        let a = self.effective_crack_length();
+        let x = graded(&[0.0, a, self.length], &[self.mesh.arm_element, self.mesh.interface_element]);
+        let nn = x.len();
+        let tip = x.iter().position(|&v| (v - a).abs() <= 1e-9 * self.length).unwrap_or(0);
+        let large = fx.large_rotation;
+        let surface = (fx.root_compliance > 0.0).then_some((tip, nn - 1));
+        let machine = fx.machine_compliance > 0.0;
+        let extra = usize::from(machine);
+        let half = self.symmetry == Symmetry::Half;
+        let (layers, factor) = if half {
+            let up =
+                Layer { section: self.section(self.h), y: 0.5 * self.h, axial: large, first: 0, last: nn - 1, surface };
+            (vec![up], 0.5)
+        } else {
+            let hl = self.h_lower.unwrap_or(self.h);
+            let lo = Layer { section: self.section(hl), y: 0.5 * hl, axial: true, first: 0, last: nn - 1, surface };
+            let up = Layer {
+                section: self.section(self.h),
+                y: hl + 0.5 * self.h,
+                axial: true,
+                first: 0,
+                last: nn - 1,
+                surface,
+            };
+            (vec![lo, up], 1.0)
+        };
+        let mesh = Mesh::new(x, layers, extra)?;
+        let upper = mesh.layers.len() - 1;
+        let mut points = Vec::with_capacity(nn - tip);
+        let mut springs = Vec::new();
+        for i in tip..nn {
+            let left = if i > tip { 0.5 * (mesh.x[i] - mesh.x[i - 1]) } else { 0.0 };
+            let right = if i + 1 < nn { 0.5 * (mesh.x[i + 1] - mesh.x[i]) } else { 0.0 };
+            let area = self.width * (left + right);
+            points.push(InterfacePoint {
+                node: i,
+                upper,
+                lower: if half { None } else { Some(0) },
+                area,
+                factor,
+                kind: PointKind::Cohesive,
+            });
+            if fx.root_compliance > 0.0 {
+                // Through-thickness spring of each arm (whole arm in the half model too).
+                for l in 0..mesh.layers.len() {
+                    springs.push(Spring { i: mesh.dofs(l, i)[3], j: NONE, k: area / fx.root_compliance, ci: 1.0 });
+                }
+            }
+        }
+        let mut fixed = Vec::new();
+        let w_up = mesh.dofs(upper, 0)[1];
+        if large || !half {
+            fixed.push(mesh.dofs(upper, 0)[0]);
+        }
+        if !half {
+            fixed.push(mesh.dofs(0, 0)[0]);
+            fixed.push(mesh.dofs(0, 0)[1]);
+        }
+        // Opening per unit of the loaded arm's deflection.
+        let arm_to_opening = if half { 2.0 } else { 1.0 };
+        let (control, scale) = if machine {
+            // Actuator unknown `a` (the crosshead opening) behind a spring of compliance C_m:
+            // elongation a − δ_specimen. In the half model the spring's energy is shared by the two
+            // halves, hence stiffness ½/C_m with the reaction being half the load.
+            let k = factor / fx.machine_compliance;
+            springs.push(Spring { i: w_up, j: 0, k, ci: arm_to_opening });
+            (
+                0,
+                RowScale {
+                    displacement: 1.0,
+                    offset: fx.displacement_offset,
+                    load: 1.0 / factor,
+                    energy: 1.0 / factor,
+                },
+            )
+        } else {
+            (
+                w_up,
+                RowScale {
+                    displacement: arm_to_opening,
+                    offset: fx.displacement_offset,
+                    load: 1.0,
+                    energy: 1.0 / factor,
+                },
+            )
+        };
+        let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: large, contact_stiffness: 0.0 };
+        Ok((p, scale))
+    }
+
+    fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
+        PathSettings {
+            target: self.max_opening(law) / scale.displacement,
+            outputs: self.control.output_points,
+            min_step_fraction: 1e-4,
+            max_dissipation_steps: 2000,
+            damage_threshold: self.control.damage_threshold,
+            crack_origin: self.effective_crack_length(),
+            newton: NewtonSettings { max_iterations: self.control.max_iterations, tolerance: self.control.tolerance },
+        }
+    }
+}
+
+#[typetag::serde(name = "dcb")]
+impl ForwardModel for Dcb {
+    fn name(&self) -> &str {
+        "dcb"
+    }
+
+    fn validate(&self) -> Result<()> {
+        Dcb::validate(self)
+    }
+
+    fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
+        let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
+        law.validate().map_err(fail)?;
+        let (p, scale) = self.problem().map_err(fail)?;
+        let path = self.path(law, &scale);
+        match fe::run(&p, law, &path) {
+            Ok((rows, _)) => Ok(beamtest::to_record(&rows, &scale)),
+            Err(f) => Err(SimulationFailure { error: f.error, partial: beamtest::to_record(&f.rows, &scale) }),
+        }
+    }
+}
+
+/// Runs `dcb` and also returns the engine's statistics (steps, iterations, factorisations).
+pub fn simulate_with_stats(dcb: &Dcb, law: &dyn CohesiveLaw) -> Result<(Record, fe::RunStats)> {
+    law.validate()?;
+    let (p, scale) = dcb.problem()?;
+    let path = dcb.path(law, &scale);
+    let (rows, stats) = fe::run(&p, law, &path).map_err(|f| f.error)?;
+    Ok((beamtest::to_record(&rows, &scale), stats))
+}

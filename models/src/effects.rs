@@ -1,0 +1,57 @@
+//! Switchable physical effects shared by the beam test models.
+//!
+//! Each effect is a plain number (or flag) in the model configuration whose null value reproduces
+//! the base model exactly: the code path with the effect switched off is the base model's, not a
+//! limit of the effect. With the effect on, responses vary smoothly with its value, so an
+//! identification can switch it on, estimate it and take finite-difference sensitivities to it.
+
+use czid_core::error::require_non_negative;
+use czid_core::{CzError, Result};
+use serde::{Deserialize, Serialize};
+
+/// Optional physics of a beam test. `Effects::default()` is the base model.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Effects {
+    /// Compliance of the machine and load train in series with the specimen (mm/N). The recorded
+    /// displacement is the crosshead's, `δ_specimen + C_m P`. 0: rigid machine.
+    pub machine_compliance: f64,
+    /// Added to the nominal initial crack length (mm); models an uncertain or blunted pre-crack
+    /// front. 0: nominal length.
+    pub crack_length_offset: f64,
+    /// Seating / zero offset (mm): the recorded displacement is `δ + offset`, with an unloaded
+    /// segment from 0 to the offset (the "toe" of a test curve). 0: none.
+    pub displacement_offset: f64,
+    /// Through-thickness compliance of each adherend between its mid-plane and the interface
+    /// (mm/MPa, i.e. mm³/N per unit area), in series with the cohesive law: the elastic
+    /// foundation of Kanninen's DCB model, which lets the crack-tip root rotate. A physical value is
+    /// `h / (2 E22)`. 0: rigid through the thickness.
+    pub root_compliance: f64,
+    /// Large rotations (co-rotational beams and interface frames) instead of small rotations.
+    pub large_rotation: bool,
+}
+
+impl Effects {
+    /// Checks every value, naming the field of `owner` that is invalid.
+    pub fn validate(&self, owner: &str) -> Result<()> {
+        require_non_negative(owner, "effects.machine_compliance", self.machine_compliance)?;
+        require_non_negative(owner, "effects.root_compliance", self.root_compliance)?;
+        if !self.crack_length_offset.is_finite() {
+            return Err(CzError::invalid(
+                owner,
+                "effects.crack_length_offset",
+                self.crack_length_offset,
+                "must be finite",
+            ));
+        }
+        if !self.displacement_offset.is_finite() {
+            return Err(CzError::invalid(
+                owner,
+                "effects.displacement_offset",
+                self.displacement_offset,
+                "must be finite",
+            ));
+        }
+        Ok(())
+    }
+}

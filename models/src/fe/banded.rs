@@ -1,0 +1,171 @@
+//! Banded matrix storage and an LU factorisation without pivoting.
+//!
+//! Beam-layer meshes numbered node by node give matrices whose non-zeros lie within a few
+//! diagonals of the main one (half-bandwidth 3 for a single layer without axial unknowns,
+//! 11 for two layers with all three unknowns per node). A dense band LU on that structure costs
+//! `n · bw²` operations with unit-stride inner loops and no index indirection; it is several times
+//! faster here than a general sparse LU (measured in `benches/forward.rs`, see the book chapter),
+//! and its "symbolic analysis" (the band) is fixed by the mesh and reused for every factorisation.
+//!
+//! No pivoting: the stiffness matrices of this engine are symmetric positive definite except
+//! where cohesive softening enters, which only adds small (possibly negative) contributions to a
+//! few diagonal 2×2 blocks. A pivot that is tiny relative to its row is reported as
+//! [`BandError::SingularPivot`] so the caller can cut the step rather than produce garbage.
+
+/// Square matrix stored by rows over the band `|i - j| <= bw`.
+#[derive(Clone, Debug)]
+pub struct BandMatrix {
+    n: usize,
+    bw: usize,
+    width: usize,
+    data: Vec<f64>,
+}
+
+/// Why a factorisation failed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BandError {
+    /// Pivot `row` was zero, not finite, or negligible against the diagonal scale.
+    SingularPivot {
+        /// Row of the pivot.
+        row: usize,
+        /// Its value.
+        value: f64,
+    },
+}
+
+impl BandMatrix {
+    /// A zero `n × n` matrix with half-bandwidth `bw`.
+    pub fn zeros(n: usize, bw: usize) -> Self {
+        let width = 2 * bw + 1;
+        BandMatrix { n, bw, width, data: vec![0.0; n * width] }
+    }
+
+    /// Order of the matrix.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Half-bandwidth.
+    pub fn bandwidth(&self) -> usize {
+        self.bw
+    }
+
+    /// Sets every stored entry to zero (keeps the allocation).
+    pub fn clear(&mut self) {
+        self.data.fill(0.0);
+    }
+
+    /// Copies the entries of `other` (same shape) into `self` without allocating.
+    pub fn copy_from(&mut self, other: &BandMatrix) {
+        debug_assert_eq!((self.n, self.bw), (other.n, other.bw));
+        self.data.copy_from_slice(&other.data);
+    }
+
+    #[inline]
+    fn idx(&self, i: usize, j: usize) -> usize {
+        i * self.width + (j + self.bw - i)
+    }
+
+    /// Entry `(i, j)`; zero outside the band.
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        if i.abs_diff(j) > self.bw {
+            0.0
+        } else {
+            self.data[self.idx(i, j)]
+        }
+    }
+
+    /// Adds `v` to entry `(i, j)`, which must lie within the band (a mesh-numbering bug otherwise).
+    #[inline]
+    pub fn add(&mut self, i: usize, j: usize, v: f64) {
+        debug_assert!(i.abs_diff(j) <= self.bw, "entry ({i},{j}) outside band {}", self.bw);
+        let k = self.idx(i, j);
+        self.data[k] += v;
+    }
+
+    /// Replaces row and column `i` by those of the identity (a prescribed unknown).
+    pub fn set_identity_row_col(&mut self, i: usize) {
+        let lo = i.saturating_sub(self.bw);
+        let hi = (i + self.bw).min(self.n - 1);
+        for j in lo..=hi {
+            let a = self.idx(i, j);
+            self.data[a] = 0.0;
+            let b = self.idx(j, i);
+            self.data[b] = 0.0;
+        }
+        let d = self.idx(i, i);
+        self.data[d] = 1.0;
+    }
+
+    /// `y = A x`.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        for (i, yi) in y.iter_mut().enumerate().take(self.n) {
+            let lo = i.saturating_sub(self.bw);
+            let hi = (i + self.bw).min(self.n - 1);
+            let row = &self.data[i * self.width..(i + 1) * self.width];
+            let mut s = 0.0;
+            for j in lo..=hi {
+                s += row[j + self.bw - i] * x[j];
+            }
+            *yi = s;
+        }
+    }
+
+    /// In-place LU factorisation without pivoting (`L` unit lower, both kept in the band).
+    pub fn factorize(&mut self) -> Result<(), BandError> {
+        let (n, bw, w) = (self.n, self.bw, self.width);
+        // Scale for the pivot test: the largest diagonal magnitude.
+        let mut scale = 0.0f64;
+        for i in 0..n {
+            scale = scale.max(self.data[i * w + bw].abs());
+        }
+        let tiny = scale * 1e-14;
+        for k in 0..n {
+            let pivot = self.data[k * w + bw];
+            if !pivot.is_finite() || pivot.abs() <= tiny {
+                return Err(BandError::SingularPivot { row: k, value: pivot });
+            }
+            let inv = 1.0 / pivot;
+            let hi = (k + bw).min(n - 1);
+            let (head, tail) = self.data.split_at_mut((k + 1) * w);
+            // Row k from column k+1 to hi.
+            let urow = &head[k * w + bw + 1..k * w + bw + 1 + (hi - k)];
+            for i in k + 1..=hi {
+                let row = &mut tail[(i - k - 1) * w..(i - k) * w];
+                // Column k of row i sits at offset k + bw - i.
+                let off = k + bw - i;
+                let l = row[off] * inv;
+                row[off] = l;
+                if l != 0.0 {
+                    for (a, u) in row[off + 1..off + 1 + (hi - k)].iter_mut().zip(urow) {
+                        *a -= l * u;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Solves `A x = b` in place with the factors from [`BandMatrix::factorize`].
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        let (n, bw, w) = (self.n, self.bw, self.width);
+        for i in 0..n {
+            let lo = i.saturating_sub(bw);
+            let row = &self.data[i * w..(i + 1) * w];
+            let mut s = b[i];
+            for j in lo..i {
+                s -= row[j + bw - i] * b[j];
+            }
+            b[i] = s;
+        }
+        for i in (0..n).rev() {
+            let hi = (i + bw).min(n - 1);
+            let row = &self.data[i * w..(i + 1) * w];
+            let mut s = b[i];
+            for j in i + 1..=hi {
+                s -= row[j + bw - i] * b[j];
+            }
+            b[i] = s / row[bw];
+        }
+    }
+}

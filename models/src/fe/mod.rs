@@ -1,0 +1,33 @@
+//! The finite-element engine: beam layers joined by zero-thickness cohesive interfaces, in 2D.
+//!
+//! One concept per module:
+//! * [`mesh`]: layers on a shared axial grid and the node-by-node numbering of unknowns;
+//! * [`beam`]: the two-node shear-locking-free Timoshenko element (small rotations);
+//! * [`corotational`]: the same element under large rotations (co-rotational);
+//! * [`interface`]: gap kinematics of nodal interface points, contact;
+//! * [`assembly`]: the discrete problem and assembly of forces and tangent;
+//! * [`banded`]: band LU factorisation (the linear solver);
+//! * [`newton`]: Newton–Raphson under displacement or dissipation control;
+//! * [`path`]: path following (adaptive steps, output grid, snap-back detours);
+//! * [`energy`]: external work, elastic and dissipated energy;
+//! * [`crack`]: debonded length, process zone and crack tip from the damage profile.
+//!
+//! Forward models ([`crate::dcb`], [`crate::enf`]) build an [`assembly::FeProblem`] from their
+//! configuration and call [`path::run`].
+
+pub mod assembly;
+pub mod banded;
+pub mod beam;
+pub mod corotational;
+pub mod crack;
+pub mod energy;
+pub mod interface;
+pub mod mesh;
+pub mod newton;
+pub mod path;
+
+pub use assembly::{FeProblem, Spring};
+pub use interface::{InterfacePoint, PointKind};
+pub use mesh::{Layer, Mesh, Section};
+pub use newton::NewtonSettings;
+pub use path::{run, PathSettings, RunStats, StepRow};

@@ -1,0 +1,202 @@
+//! Newton–Raphson iterations with the consistent (unsymmetric) tangent, for one load step under
+//! displacement control or under a dissipation constraint.
+
+use czid_core::{CohesiveLaw, LawState};
+
+use super::assembly::{Assembler, FeProblem};
+use super::banded::BandMatrix;
+
+/// Convergence settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSettings {
+    /// Maximum iterations per step before the step is declared failed (and cut).
+    pub max_iterations: usize,
+    /// Relative residual tolerance: `max |r_i| ≤ tol · max |f_int|`.
+    pub tolerance: f64,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        NewtonSettings { max_iterations: 12, tolerance: 1e-9 }
+    }
+}
+
+/// Why a step did not converge.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepFailure {
+    /// No convergence within the iteration limit.
+    NoConvergence,
+    /// Tangent singular (or a non-finite pivot).
+    Singular,
+    /// A law returned a non-finite traction or tangent.
+    NonFinite,
+}
+
+/// Newton workspace: the tangent, residual and two solution vectors, allocated once per run.
+pub struct Newton {
+    /// Assembly workspace (constant tangent part, trial law results).
+    pub asm: Assembler,
+    /// Tangent, factorised in place.
+    pub k: BandMatrix,
+    /// Internal forces at the last assembly.
+    pub f: Vec<f64>,
+    r: Vec<f64>,
+    b: Vec<f64>,
+    fixed_mask: Vec<bool>,
+    /// Settings.
+    pub settings: NewtonSettings,
+    /// Total iterations (assemblies) and factorisations so far, for profiling.
+    pub counters: (usize, usize),
+}
+
+impl Newton {
+    /// Workspace for problem `p`.
+    pub fn new(p: &FeProblem, settings: NewtonSettings) -> Self {
+        let asm = Assembler::new(p);
+        let n = asm.n();
+        let mut fixed_mask = vec![false; n];
+        for &d in &p.fixed {
+            fixed_mask[d] = true;
+        }
+        Newton {
+            k: BandMatrix::zeros(n, p.mesh.bandwidth()),
+            asm,
+            f: vec![0.0; n],
+            r: vec![0.0; n],
+            b: vec![0.0; n],
+            fixed_mask,
+            settings,
+            counters: (0, 0),
+        }
+    }
+
+    fn assemble(
+        &mut self,
+        p: &FeProblem,
+        law: &dyn CohesiveLaw,
+        states: &[LawState],
+        q: &[f64],
+    ) -> Result<(), StepFailure> {
+        self.counters.0 += 1;
+        if self.asm.assemble(p, law, states, q, &mut self.k, &mut self.f) {
+            Ok(())
+        } else {
+            Err(StepFailure::NonFinite)
+        }
+    }
+
+    fn scale(&self) -> f64 {
+        self.f.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300)
+    }
+
+    /// Solves for equilibrium with the control unknown held at `q[p.control]` (already set in the
+    /// predictor `q`). On success `q` is the converged state, `self.f` its internal forces and
+    /// `self.asm.trial` its law results; returns the number of iterations.
+    pub fn solve_displacement(
+        &mut self,
+        p: &FeProblem,
+        law: &dyn CohesiveLaw,
+        states: &[LawState],
+        q: &mut [f64],
+    ) -> Result<usize, StepFailure> {
+        let mut stalled = false;
+        for it in 0..=self.settings.max_iterations {
+            self.assemble(p, law, states, q)?;
+            let tol = self.settings.tolerance * self.scale();
+            let mut rmax = 0.0f64;
+            for i in 0..q.len() {
+                let v = if self.fixed_mask[i] || i == p.control { 0.0 } else { self.f[i] };
+                self.r[i] = -v;
+                rmax = rmax.max(v.abs());
+            }
+            if !rmax.is_finite() {
+                return Err(StepFailure::NonFinite);
+            }
+            // Very stiff penalties make the residual's round-off floor exceed the tolerance; a
+            // correction at round-off level with a small residual is then as converged as it gets.
+            if rmax <= tol || (stalled && rmax <= 1e4 * tol) {
+                return Ok(it);
+            }
+            if it == self.settings.max_iterations {
+                break;
+            }
+            for &d in &p.fixed {
+                self.k.set_identity_row_col(d);
+            }
+            self.k.set_identity_row_col(p.control);
+            self.counters.1 += 1;
+            self.k.factorize().map_err(|_| StepFailure::Singular)?;
+            self.k.solve_in_place(&mut self.r);
+            let (mut dmax, mut qmax) = (0.0f64, 0.0f64);
+            for (qi, di) in q.iter_mut().zip(&self.r) {
+                *qi += di;
+                dmax = dmax.max(di.abs());
+                qmax = qmax.max(qi.abs());
+            }
+            stalled = dmax <= 1e-12 * qmax;
+        }
+        Err(StepFailure::NoConvergence)
+    }
+
+    /// Solves for equilibrium under the dissipation constraint of Gutiérrez (2004) / Verhoosel
+    /// et al. (2009): the control unknown is free and loaded by the load factor `λ`, and
+    /// `½ (λ₀ (c − c₀) − (λ − λ₀) c₀) = τ` fixes the energy released in the step. `q` and `lambda`
+    /// hold the predictor on entry and the converged state on success.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_dissipation(
+        &mut self,
+        p: &FeProblem,
+        law: &dyn CohesiveLaw,
+        states: &[LawState],
+        q: &mut [f64],
+        lambda: &mut f64,
+        c0: f64,
+        lambda0: f64,
+        tau: f64,
+    ) -> Result<usize, StepFailure> {
+        let ic = p.control;
+        for it in 0..=self.settings.max_iterations {
+            self.assemble(p, law, states, q)?;
+            let tol = self.settings.tolerance * self.scale();
+            let mut rmax = 0.0f64;
+            for i in 0..q.len() {
+                let mut v = if self.fixed_mask[i] { 0.0 } else { self.f[i] };
+                if i == ic {
+                    v -= *lambda;
+                }
+                self.r[i] = -v;
+                rmax = rmax.max(v.abs());
+            }
+            let g = 0.5 * (lambda0 * (q[ic] - c0) - (*lambda - lambda0) * c0) - tau;
+            if !rmax.is_finite() || !g.is_finite() {
+                return Err(StepFailure::NonFinite);
+            }
+            if rmax <= tol && g.abs() <= 1e-9 * tau.abs().max(1e-300) {
+                return Ok(it);
+            }
+            if it == self.settings.max_iterations {
+                break;
+            }
+            for &d in &p.fixed {
+                self.k.set_identity_row_col(d);
+            }
+            self.counters.1 += 1;
+            self.k.factorize().map_err(|_| StepFailure::Singular)?;
+            self.k.solve_in_place(&mut self.r);
+            self.b.fill(0.0);
+            self.b[ic] = 1.0;
+            self.k.solve_in_place(&mut self.b);
+            // Bordering: Δq = a + Δλ b, with the constraint linearised in (c, λ).
+            let den = 0.5 * lambda0 * self.b[ic] - 0.5 * c0;
+            if den == 0.0 || !den.is_finite() {
+                return Err(StepFailure::Singular);
+            }
+            let dl = (-g - 0.5 * lambda0 * self.r[ic]) / den;
+            for i in 0..q.len() {
+                q[i] += self.r[i] + dl * self.b[i];
+            }
+            *lambda += dl;
+        }
+        Err(StepFailure::NoConvergence)
+    }
+}
