@@ -59,10 +59,10 @@ pub struct StCzm {
     /// Slip at which the traction vanishes (mm); paper Δu_t,c (tables).
     pub u_c_t: f64,
     /// Softening shape of the normal strength model (default: sawtooth).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "StrengthShape::is_sawtooth")]
     pub shape_n: StrengthShape,
     /// Softening shape of the shear strength model (default: sawtooth).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "StrengthShape::is_sawtooth")]
     pub shape_t: StrengthShape,
 }
 

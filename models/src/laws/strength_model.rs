@@ -40,6 +40,11 @@ pub enum StrengthShape {
 }
 
 impl StrengthShape {
+    /// Whether this is the default (sawtooth) shape; such shapes are left out of written files.
+    pub fn is_sawtooth(&self) -> bool {
+        *self == StrengthShape::Sawtooth
+    }
+
     /// Short name, as written in configuration files.
     pub fn name(&self) -> &'static str {
         match self {
