@@ -1,9 +1,17 @@
-//! The `czid` command.
+//! The `czid` command: simulate, identify and compare on problem files; the bundled demo.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
+use czid_core::CzError;
+use czid_problems::compare::{compare, CompareOptions};
+use czid_problems::identify::{identify, simulate, RunOptions};
+use czid_problems::output::OutputDir;
+use czid_problems::problem_file::LoadedProblem;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
-/// Identify cohesive-zone interface laws from laboratory tests.
+/// Identify cohesive-zone interface laws from laboratory tests (units: N, mm, MPa).
 #[derive(Parser)]
 #[command(name = "czid", version, about)]
 struct Cli {
@@ -13,14 +21,81 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run the bundled end-to-end example.
-    Demo,
+    /// Run the bundled paper-DCB identification end to end and say where the results are.
+    Demo {
+        /// Output folder (overwritten).
+        #[arg(long, default_value = "out/demo")]
+        out: PathBuf,
+    },
+    /// Run the forward models at the problem file's initial values.
+    Simulate {
+        /// Problem file (TOML).
+        problem: PathBuf,
+        #[command(flatten)]
+        out: OutArgs,
+    },
+    /// Identify the problem file's parameters.
+    Identify {
+        /// Problem file (TOML).
+        problem: PathBuf,
+        #[command(flatten)]
+        out: OutArgs,
+        /// Optimizer instead of the file's (e.g. miga, ga, nsga2, nelder-mead, lbfgs, levenberg-marquardt, hybrid).
+        #[arg(long)]
+        optimizer: Option<String>,
+        /// Random seed instead of the file's.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Evaluation budget instead of the file's.
+        #[arg(long)]
+        budget: Option<usize>,
+        /// Continue an interrupted run from the checkpoint in the output folder.
+        #[arg(long)]
+        resume: bool,
+    },
+    /// Compare optimizers over several seeds at equal budgets.
+    Compare {
+        /// Problem file (TOML).
+        problem: PathBuf,
+        /// Optimizers, comma separated (e.g. miga,nsga2,nelder-mead,hybrid).
+        #[arg(long, value_delimiter = ',', required = true)]
+        optimizers: Vec<String>,
+        /// Number of seeds per optimizer.
+        #[arg(long, default_value_t = 10)]
+        seeds: u64,
+        /// Evaluation budget per run instead of the file's.
+        #[arg(long)]
+        budget: Option<usize>,
+        /// Objective value that counts as success.
+        #[arg(long, default_value_t = 1e-3)]
+        target: f64,
+        #[command(flatten)]
+        out: OutArgs,
+    },
+}
+
+#[derive(Args)]
+struct OutArgs {
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Overwrite results already in the output folder.
+    #[arg(long)]
+    force: bool,
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
-        Command::Demo => demo(),
+        Command::Demo { out } => demo(&out),
+        Command::Simulate { problem, out } => run_simulate(&problem, &out),
+        Command::Identify { problem, out, optimizer, seed, budget, resume } => {
+            let opts = RunOptions { optimizer, seed, budget, progress: true, resume, stop: Some(ctrl_c_flag()) };
+            run_identify(&problem, &out, &opts)
+        }
+        Command::Compare { problem, optimizers, seeds, budget, target, out } => {
+            run_compare(&problem, &out, &CompareOptions { optimizers, seeds, budget, target })
+        }
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -31,10 +106,79 @@ fn main() -> ExitCode {
     }
 }
 
-fn demo() -> Result<(), czid_core::CzError> {
-    Err(czid_core::CzError::config(
-        "czid demo",
-        "the end-to-end identification demo is not part of this version yet; \
-         see the book's Quick start for what runs today",
-    ))
+/// A flag raised by Ctrl-C: the optimizer stops after its current iteration, leaving a checkpoint
+/// and a partial result.
+fn ctrl_c_flag() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let f = flag.clone();
+    // Without a handler (e.g. one is already installed) Ctrl-C simply ends the process, which
+    // loses only the work since the last checkpoint.
+    let _ = ctrlc::set_handler(move || f.store(true, Ordering::SeqCst));
+    flag
+}
+
+fn run_simulate(problem: &Path, out: &OutArgs) -> Result<(), CzError> {
+    let problem = LoadedProblem::read(problem)?;
+    let dir = OutputDir::create(&out.out, out.force, false)?;
+    simulate(&problem, &dir)?;
+    println!("curves and plots written to {}", dir.path().display());
+    Ok(())
+}
+
+fn run_identify(problem: &Path, out: &OutArgs, opts: &RunOptions) -> Result<(), CzError> {
+    let problem = LoadedProblem::read(problem)?;
+    let dir = OutputDir::create(&out.out, out.force, opts.resume)?;
+    let res = identify(&problem, opts, &dir)?;
+    if res.partial {
+        println!("interrupted: best so far in {}; continue with --resume", dir.file("result.partial.json").display());
+    }
+    println!("objective f = {:.4e} after {} evaluations in {:.1} s", res.objective, res.evaluations, res.wall_seconds);
+    for (path, p) in &res.parameters {
+        println!("  {path:<28} = {:>12.6e} {:<8} {}", p.value, p.unit, p.verdict);
+    }
+    for w in &res.warnings {
+        println!("warning: {w}");
+    }
+    println!("results, fits and plots in {}", dir.path().display());
+    Ok(())
+}
+
+fn run_compare(problem: &Path, out: &OutArgs, opts: &CompareOptions) -> Result<(), CzError> {
+    let problem = LoadedProblem::read(problem)?;
+    let dir = OutputDir::create(&out.out, out.force, false)?;
+    let runs = compare(&problem, opts, &dir)?;
+    println!("{:<20} {:>6} {:>12} {:>12} {:>10}", "optimizer", "runs", "median f", "success", "median s");
+    for name in &opts.optimizers {
+        let mine: Vec<_> = runs.iter().filter(|r| &r.optimizer == name).collect();
+        let mut f: Vec<f64> = mine.iter().map(|r| r.best).collect();
+        let mut t: Vec<f64> = mine.iter().map(|r| r.wall_seconds).collect();
+        f.sort_by(f64::total_cmp);
+        t.sort_by(f64::total_cmp);
+        let ok = mine.iter().filter(|r| r.evaluations_to_target.is_some()).count();
+        println!(
+            "{name:<20} {:>6} {:>12.4e} {:>9}/{:<2} {:>10.2}",
+            mine.len(),
+            f[f.len() / 2],
+            ok,
+            mine.len(),
+            t[t.len() / 2]
+        );
+    }
+    println!("summary, convergence and plots in {}", dir.path().display());
+    Ok(())
+}
+
+fn demo(out: &Path) -> Result<(), CzError> {
+    let problem = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/paper-dcb/problem.toml");
+    if !problem.exists() {
+        return Err(CzError::config(
+            "czid demo",
+            "the bundled paper-DCB problem is not part of this version yet; see the book's Quick start",
+        ));
+    }
+    run_identify(
+        &problem,
+        &OutArgs { out: out.to_path_buf(), force: true },
+        &RunOptions { progress: true, stop: Some(ctrl_c_flag()), ..RunOptions::default() },
+    )
 }

@@ -12,7 +12,7 @@ use czid_optimizers::observers::{CsvHistory, Observers, ProgressBar};
 use czid_optimizers::registry::{local_from_config, optimizer_from_config};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -86,11 +86,10 @@ pub struct IdentifyResult {
     pub warnings: Vec<String>,
 }
 
-/// Counts evaluations and the time spent in them.
+/// Measures the time spent in forward simulations.
 struct Timed<'a> {
     inner: &'a Identification,
     nanos: AtomicU64,
-    calls: AtomicUsize,
 }
 
 impl Problem for Timed<'_> {
@@ -104,7 +103,6 @@ impl Problem for Timed<'_> {
         let t = Instant::now();
         let r = self.inner.evaluate(x);
         self.nanos.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
-        self.calls.fetch_add(1, Ordering::Relaxed);
         r
     }
     fn objectives(&self) -> usize {
@@ -125,6 +123,49 @@ impl Observer for StopFlag {
 
 const LOCAL: &[&str] = &["nelder-mead", "lbfgs", "gauss-newton", "levenberg-marquardt", "lm"];
 
+/// One optimisation run and what it cost.
+pub struct Run {
+    /// The optimizer's result (unit-cube coordinates).
+    pub result: OptimizationResult,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+    /// Time spent in forward simulations, summed over threads (s).
+    pub forward_seconds: f64,
+}
+
+/// Runs optimizer `name` with `settings` on `id`. Local methods start from the initial values;
+/// global ones sample the bounds. `resume` continues from a checkpoint's state.
+pub fn optimize(
+    id: &Identification,
+    name: &str,
+    settings: &toml::Value,
+    seed: u64,
+    budget: &Budget,
+    resume: Option<&str>,
+    observer: &mut dyn Observer,
+) -> Result<Run> {
+    let timed = Timed { inner: id, nanos: AtomicU64::new(0) };
+    let start = Instant::now();
+    let result = if LOCAL.contains(&name) {
+        if resume.is_some() {
+            return Err(CzError::config("--resume", format!("`{name}` cannot resume; run it again")));
+        }
+        let u0 = id.space().to_unit(&id.initial()?);
+        local_from_config(name, settings)?.minimize_from(&timed, budget, &u0, observer)?
+    } else {
+        let optimizer = optimizer_from_config(name, settings)?;
+        match resume {
+            Some(state) => optimizer.resume(&timed, budget, state, observer)?,
+            None => optimizer.minimize(&timed, budget, seed, observer)?,
+        }
+    };
+    Ok(Run {
+        result,
+        wall_seconds: start.elapsed().as_secs_f64(),
+        forward_seconds: timed.nanos.load(Ordering::Relaxed) as f64 * 1e-9,
+    })
+}
+
 /// Runs the identification described by `problem`, writing into `out`.
 pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> Result<IdentifyResult> {
     let id = problem.identification()?;
@@ -142,31 +183,22 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         return Err(CzError::config("--budget", "must be at least 1 evaluation"));
     }
     let x0 = id.initial()?;
-    let u0 = id.space().to_unit(&x0);
 
-    let timed = Timed { inner: &id, nanos: AtomicU64::new(0), calls: AtomicUsize::new(0) };
     let mut history = CsvHistory::create(&out.file("history.csv"))?;
     let mut checkpoint = CheckpointWriter::new(out.file("checkpoint.json"), 1)?;
     let mut bar =
         if opts.progress { ProgressBar::new(budget.evaluations) } else { ProgressBar::hidden(budget.evaluations) };
     let mut stop = StopFlag(opts.stop.clone(), false);
-    let start = Instant::now();
-    let result: OptimizationResult = {
-        let mut observers = Observers(vec![&mut history, &mut checkpoint, &mut bar, &mut stop]);
-        if LOCAL.contains(&name.as_str()) {
-            let local = local_from_config(&name, &settings)?;
-            local.minimize_from(&timed, &budget, &u0, &mut observers)?
-        } else {
-            let optimizer = optimizer_from_config(&name, &settings)?;
-            if opts.resume {
-                let state = czid_optimizers::checkpoint::read_checkpoint(&out.file("checkpoint.json"))?;
-                optimizer.resume(&timed, &budget, &state, &mut observers)?
-            } else {
-                optimizer.minimize(&timed, &budget, seed, &mut observers)?
-            }
-        }
+    let resume_state = if opts.resume {
+        Some(czid_optimizers::checkpoint::read_checkpoint(&out.file("checkpoint.json"))?)
+    } else {
+        None
     };
-    let wall = start.elapsed().as_secs_f64();
+    let run = {
+        let mut observers = Observers(vec![&mut history, &mut checkpoint, &mut bar, &mut stop]);
+        optimize(&id, &name, &settings, seed, &budget, resume_state.as_deref(), &mut observers)?
+    };
+    let (result, wall, forward_seconds) = (run.result, run.wall_seconds, run.forward_seconds);
     bar.finish();
     history.finish()?;
     let partial = stop.1;
@@ -210,7 +242,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         evaluations: result.evaluations,
         failed_evaluations: result.failures,
         wall_seconds: wall,
-        forward_share: timed.nanos.load(Ordering::Relaxed) as f64 * 1e-9 / wall.max(1e-12),
+        forward_share: forward_seconds / wall.max(1e-12),
         warnings,
     };
     let json = serde_json::to_string_pretty(&res).map_err(|e| CzError::config("result", e.to_string()))?;

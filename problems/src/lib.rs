@@ -1,5 +1,6 @@
 //! # czid-problems: inverse problems built from laws, forward models and optimizers
 //!
+//! * [`compare`]: several optimizers × seeds at equal budgets, with summary and plots.
 //! * [`data`]: experimental curves from CSV, checked and converted to N and mm.
 //! * [`identification`]: a shared law, per-experiment forward models, parameters and the
 //!   composite objective as a [`czid_core::Problem`] on the unit cube.
@@ -9,6 +10,7 @@
 //! * [`plot`]: line plots (PNG/SVG) with a bundled font, written atomically.
 //! * [`problem_file`]: the TOML problem file (law, experiments, parameters, objective, optimizer).
 
+pub mod compare;
 pub mod data;
 pub mod identifiability;
 pub mod identification;

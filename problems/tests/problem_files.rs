@@ -202,3 +202,22 @@ fn identify_recovers_the_known_answer_and_writes_results() {
     let again = identify(&p, &RunOptions::default(), &out2).unwrap();
     assert_eq!(again.parameters["law.stiffness"].value, k);
 }
+
+#[test]
+fn compare_runs_every_optimizer_and_seed_and_writes_summary() {
+    use czid_problems::compare::{compare, CompareOptions};
+    use czid_problems::output::OutputDir;
+    let dir = setup_dir("compare", &problem_text("").replace("budget = 100", "budget = 200"));
+    let p = read(&dir).unwrap();
+    let out = OutputDir::create(&dir.join("out"), false, false).unwrap();
+    let opts =
+        CompareOptions { optimizers: vec!["miga".into(), "nelder-mead".into()], seeds: 2, budget: None, target: 1e-3 };
+    let runs = compare(&p, &opts, &out).unwrap();
+    assert_eq!(runs.len(), 4);
+    assert!(runs.iter().all(|r| r.evaluations <= 200));
+    let summary = std::fs::read_to_string(out.file("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 5, "{summary}");
+    for f in ["convergence.csv", "convergence.png", "final_objective.png"] {
+        assert!(out.file(f).exists(), "{f} missing");
+    }
+}
