@@ -132,7 +132,7 @@ fn misspelt_keys_are_named() {
 #[test]
 fn invalid_values_are_named() {
     let st = |overrides: &str| {
-        let mut fields = vec![
+        let mut fields = [
             ("strength_n", "27.0"),
             ("u_e_n", "0.00027"),
             ("u_c_n", "0.003273"),
