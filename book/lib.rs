@@ -5,3 +5,5 @@
 pub mod introduction {}
 #[doc = include_str!("src/concepts.md")]
 pub mod concepts {}
+#[doc = include_str!("src/optimizers.md")]
+pub mod optimizers {}
