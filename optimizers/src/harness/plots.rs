@@ -84,7 +84,12 @@ fn draw_convergence<DB: DrawingBackend>(
     root.fill(&WHITE)?;
     let all = bands.iter().flat_map(|(_, p)| p.iter().flat_map(|&(_, a, _, c)| [a, c]));
     let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
-    let (lo, hi) = if lo.is_finite() { (lo / 2.0, hi * 2.0) } else { (FLOOR, 1.0) };
+    // Whole decades, so the logarithmic axis labels every power of ten in view.
+    let (lo, hi) = if lo.is_finite() {
+        (10f64.powf(lo.log10().floor()), 10f64.powf((hi.log10() + 1e-9).ceil()))
+    } else {
+        (FLOOR, 1.0)
+    };
     let mut chart = ChartBuilder::on(root)
         .caption(format!("{problem}: best f − f* (median, quartile band)"), (FAMILY, 22))
         .margin(12)
@@ -95,6 +100,7 @@ fn draw_convergence<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("evaluations")
         .y_desc("best f − f*")
+        .y_labels(12)
         .x_label_formatter(&|v| format!("{v:.0}"))
         .label_style((FAMILY, 14))
         .axis_desc_style((FAMILY, 16))
