@@ -107,7 +107,7 @@ impl Default for ControlSettings {
             max_displacement: None,
             output_points: 100,
             damage_threshold: 1.0 - 1e-9,
-            max_iterations: 12,
+            max_iterations: 20,
             tolerance: 1e-9,
         }
     }

@@ -275,7 +275,7 @@ impl Dcb {
         PathSettings {
             target: self.max_opening(law) / scale.displacement,
             outputs: self.control.output_points,
-            min_step_fraction: 1e-4,
+            min_step_fraction: 1e-3,
             max_dissipation_steps: 2000,
             damage_threshold: self.control.damage_threshold,
             crack_origin: self.effective_crack_length(),

@@ -6,7 +6,7 @@
 //! re-assembled each iteration. No allocation happens per iteration: every buffer lives in the
 //! [`Assembler`].
 
-use czid_core::{CohesiveLaw, Gap, LawEval, LawState};
+use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent};
 
 use super::banded::BandMatrix;
 use super::beam;
@@ -65,7 +65,11 @@ pub struct Assembler {
     /// Gaps of the last assembly.
     pub gaps: Vec<Gap>,
     n: usize,
+    strength: [f64; 2],
 }
+
+/// Relative margin within which a cohesive point iterates with its loading-branch tangent.
+pub const LOADING_BIAS: f64 = 1e-3;
 
 #[inline]
 fn get(q: &[f64], d: usize) -> f64 {
@@ -78,7 +82,7 @@ fn get(q: &[f64], d: usize) -> f64 {
 
 impl Assembler {
     /// Prepares element lists and the constant part of the tangent.
-    pub fn new(p: &FeProblem) -> Self {
+    pub fn new(p: &FeProblem, law: &dyn CohesiveLaw) -> Self {
         let mesh = &p.mesh;
         let mut elements = Vec::new();
         for (k, layer) in mesh.layers.iter().enumerate() {
@@ -111,7 +115,9 @@ impl Assembler {
         }
         let np = p.points.len();
         let zero = LawEval { traction: Default::default(), tangent: Default::default(), state: LawState::default() };
-        Assembler { elements, linear, trial: vec![zero; np], gaps: vec![Gap::zeros(); np], n }
+        let st = law.strength();
+        let strength = [st[0].abs().max(1e-300), st[1].abs().max(1e-300)];
+        Assembler { elements, linear, trial: vec![zero; np], gaps: vec![Gap::zeros(); np], n, strength }
     }
 
     /// Internal forces `f` and tangent `k` at `q`, laws evaluated from the committed `states`.
@@ -124,6 +130,7 @@ impl Assembler {
         q: &[f64],
         k: &mut BandMatrix,
         f: &mut [f64],
+        secant: bool,
     ) -> bool {
         k.copy_from(&self.linear);
         self.linear.mul_vec(q, f);
@@ -147,12 +154,22 @@ impl Assembler {
         for (ip, pt) in p.points.iter().enumerate() {
             let kin = interface::kinematics(&p.mesh, pt, q, p.large_rotation);
             let gap = Gap::new(kin.gap[0], kin.gap[1]);
-            let ev = match pt.kind {
-                PointKind::Cohesive => law.evaluate(&gap, &states[ip]),
-                PointKind::Contact => interface::contact(&gap, p.contact_stiffness),
+            let (ev, d) = match pt.kind {
+                PointKind::Cohesive => {
+                    let ev = law.evaluate(&gap, &states[ip]);
+                    let d = if secant {
+                        secant_tangent(&gap, &ev)
+                    } else {
+                        self.loading_tangent(law, &gap, &states[ip], &ev)
+                    };
+                    (ev, d)
+                }
+                PointKind::Contact => {
+                    let ev = interface::contact(&gap, p.contact_stiffness);
+                    (ev, ev.tangent)
+                }
             };
             let t = ev.traction;
-            let d = ev.tangent;
             if !(t[0].is_finite() && t[1].is_finite() && d.iter().all(|v| v.is_finite())) {
                 ok = false;
             }
@@ -188,6 +205,35 @@ impl Assembler {
         ok
     }
 
+    /// Tangent for the iteration matrix of a cohesive point.
+    ///
+    /// A point sitting on (or just inside) its damage surface has two one-sided tangents: the
+    /// secant one if it unloads and the softening one if it loads. The law returns the secant one
+    /// unless the trial gap is strictly beyond the committed surface, so a whole process zone can
+    /// flip between the two from one iteration to the next and Newton cycles (and the bordered
+    /// dissipation-controlled system becomes singular at a converged state, where every damaging
+    /// point is exactly on its surface). Points within a relative [`LOADING_BIAS`] of their surface
+    /// therefore iterate with the loading-branch tangent, obtained from the law at a gap enlarged
+    /// by that margin. Only the iteration matrix changes; tractions, hence converged solutions,
+    /// are the law's own.
+    fn loading_tangent(&self, law: &dyn CohesiveLaw, gap: &Gap, state: &LawState, ev: &LawEval) -> Tangent {
+        if ev.state.damage > state.damage || ev.state.damage >= 1.0 {
+            return ev.tangent; // already loading, or nothing left to damage
+        }
+        // Far from the surface (low traction, no damage) the secant is the tangent.
+        let s = &self.strength;
+        let ratio = (ev.traction[0].max(0.0) / s[0]).powi(2) + (ev.traction[1] / s[1]).powi(2);
+        if state.damage <= 0.0 && ratio < 0.8 {
+            return ev.tangent;
+        }
+        let probe = law.evaluate(&(gap * (1.0 + LOADING_BIAS)), state);
+        if probe.state.damage > state.damage && probe.tangent.iter().all(|v| v.is_finite()) {
+            probe.tangent
+        } else {
+            ev.tangent
+        }
+    }
+
     /// Strain energy of the beams and springs (N·mm) at `q`.
     pub fn structural_energy(&self, p: &FeProblem, q: &[f64]) -> f64 {
         let mut e = 0.0;
@@ -214,6 +260,18 @@ impl Assembler {
     pub fn n(&self) -> usize {
         self.n
     }
+}
+
+/// Secant stiffness `diag(T_n/g_n, T_t/g_t)` of a damage law (whose tractions are proportional to
+/// the gap components), falling back to the tangent's diagonal at a zero gap component. Always
+/// non-negative for such laws, so iterations with it cannot cycle between branches.
+fn secant_tangent(gap: &Gap, ev: &LawEval) -> Tangent {
+    let mut d = Tangent::zeros();
+    for i in 0..2 {
+        d[(i, i)] = if gap[i].abs() > 1e-14 { ev.traction[i] / gap[i] } else { ev.tangent[(i, i)].max(0.0) };
+        d[(i, i)] = d[(i, i)].max(0.0);
+    }
+    d
 }
 
 fn scatter(k: &mut BandMatrix, dofs: &[usize; 6], ke: &[[f64; 6]; 6]) {

@@ -17,7 +17,7 @@ pub struct NewtonSettings {
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        NewtonSettings { max_iterations: 12, tolerance: 1e-9 }
+        NewtonSettings { max_iterations: 20, tolerance: 1e-9 }
     }
 }
 
@@ -51,8 +51,8 @@ pub struct Newton {
 
 impl Newton {
     /// Workspace for problem `p`.
-    pub fn new(p: &FeProblem, settings: NewtonSettings) -> Self {
-        let asm = Assembler::new(p);
+    pub fn new(p: &FeProblem, law: &dyn CohesiveLaw, settings: NewtonSettings) -> Self {
+        let asm = Assembler::new(p, law);
         let n = asm.n();
         let mut fixed_mask = vec![false; n];
         for &d in &p.fixed {
@@ -76,9 +76,10 @@ impl Newton {
         law: &dyn CohesiveLaw,
         states: &[LawState],
         q: &[f64],
+        secant: bool,
     ) -> Result<(), StepFailure> {
         self.counters.0 += 1;
-        if self.asm.assemble(p, law, states, q, &mut self.k, &mut self.f) {
+        if self.asm.assemble(p, law, states, q, &mut self.k, &mut self.f, secant) {
             Ok(())
         } else {
             Err(StepFailure::NonFinite)
@@ -100,8 +101,18 @@ impl Newton {
         q: &mut [f64],
     ) -> Result<usize, StepFailure> {
         let mut stalled = false;
-        for it in 0..=self.settings.max_iterations {
-            self.assemble(p, law, states, q)?;
+        // Safeguard against branch cycling: a correction that increased the residual is halved,
+        // and the next iterations use the secant stiffness of the cohesive points (a fixed-point
+        // iteration that converges monotonically while the active set settles) before Newton
+        // resumes.
+        let mut r_prev = f64::INFINITY;
+        let mut alpha = 1.0f64;
+        let mut secant_left = 0usize;
+        let mut it = 0usize;
+        let max_it = self.settings.max_iterations;
+        while it <= max_it {
+            let secant = secant_left > 0;
+            self.assemble(p, law, states, q, secant)?;
             let tol = self.settings.tolerance * self.scale();
             let mut rmax = 0.0f64;
             for i in 0..q.len() {
@@ -117,9 +128,22 @@ impl Newton {
             if rmax <= tol || (stalled && rmax <= 1e4 * tol) {
                 return Ok(it);
             }
-            if it == self.settings.max_iterations {
+            if rmax > r_prev && alpha > 0.3 {
+                alpha *= 0.5;
+                for (qi, di) in q.iter_mut().zip(&self.b) {
+                    *qi -= alpha * di;
+                }
+                secant_left = 4;
+                it += 1;
+                continue;
+            }
+            if it >= max_it {
                 break;
             }
+            it += 1;
+            secant_left = secant_left.saturating_sub(1);
+            r_prev = rmax;
+            alpha = 1.0;
             for &d in &p.fixed {
                 self.k.set_identity_row_col(d);
             }
@@ -128,8 +152,9 @@ impl Newton {
             self.k.factorize().map_err(|_| StepFailure::Singular)?;
             self.k.solve_in_place(&mut self.r);
             let (mut dmax, mut qmax) = (0.0f64, 0.0f64);
-            for (qi, di) in q.iter_mut().zip(&self.r) {
+            for ((qi, di), bi) in q.iter_mut().zip(&self.r).zip(self.b.iter_mut()) {
                 *qi += di;
+                *bi = *di;
                 dmax = dmax.max(di.abs());
                 qmax = qmax.max(qi.abs());
             }
@@ -156,7 +181,7 @@ impl Newton {
     ) -> Result<usize, StepFailure> {
         let ic = p.control;
         for it in 0..=self.settings.max_iterations {
-            self.assemble(p, law, states, q)?;
+            self.assemble(p, law, states, q, false)?;
             let tol = self.settings.tolerance * self.scale();
             let mut rmax = 0.0f64;
             for i in 0..q.len() {

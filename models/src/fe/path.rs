@@ -91,7 +91,7 @@ struct State {
 
 /// Runs problem `p` with `law` along the path described by `s`.
 pub fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Vec<StepRow>, RunStats), PathFailure> {
-    let mut nw = Newton::new(p, s.newton);
+    let mut nw = Newton::new(p, law, s.newton);
     let n = nw.asm.n();
     let np = p.points.len();
     let cohesive: Vec<usize> = (0..np).filter(|&i| p.points[i].kind == PointKind::Cohesive).collect();
@@ -157,107 +157,118 @@ pub fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Ve
         }};
     }
 
-    while k_out <= s.outputs {
-        let next = if k_out == s.outputs { s.target.abs() } else { spacing * k_out as f64 };
-        let dh = h.min(next - pos);
-        // Predictor: extrapolate the last increment.
-        let alpha = if h_prev > 0.0 { dh / h_prev } else { 0.0 };
-        for i in 0..n {
-            trial[i] = cur.q[i] + alpha * (cur.q[i] - prev_q[i]);
+    let target = s.target.abs();
+    let eps = 1e-12 * spacing;
+    let mut dissipating = false;
+    // After a detour through dissipation control, one failed displacement step sends the path
+    // straight back (no step halving): the snap-backs of a propagating crack come one per node.
+    let mut quick_fallback = false;
+    let mut tau = 0.0f64;
+    let mut last: Option<(f64, f64)> = None;
+    let max_steps = 200 * s.outputs + 20_000;
+    while pos < target - eps {
+        if stats.steps > max_steps {
+            return Err(fail(rows, format!("gave up after {} steps at control {:.6}", stats.steps, dir * pos)));
         }
-        trial[ic] = dir * (pos + dh);
-        match nw.solve_displacement(p, law, &cur.states, &mut trial) {
-            Ok(it) => {
-                let reaction = nw.f[ic];
-                commit!(reaction);
-                pos += dh;
-                h_prev = dh;
-                if (next - pos).abs() <= 1e-12 * spacing {
-                    pos = next;
-                    k_out += 1;
+        if !dissipating {
+            while k_out < s.outputs && spacing * k_out as f64 <= pos + eps {
+                k_out += 1;
+            }
+            let next = if k_out >= s.outputs { target } else { spacing * k_out as f64 };
+            let dh = h.min(next - pos);
+            // Predictor: extrapolate the last increment.
+            let alpha = if h_prev > 0.0 { dh / h_prev } else { 0.0 };
+            for i in 0..n {
+                trial[i] = cur.q[i] + alpha * (cur.q[i] - prev_q[i]);
+            }
+            trial[ic] = dir * (pos + dh);
+            match nw.solve_displacement(p, law, &cur.states, &mut trial) {
+                Ok(it) => {
+                    let reaction = nw.f[ic];
+                    commit!(reaction);
+                    pos = if (next - (pos + dh)).abs() <= eps { next } else { pos + dh };
+                    h_prev = dh;
+                    quick_fallback = false;
+                    if it <= 3 {
+                        h = (2.0 * h).min(spacing);
+                    } else if it >= 7 {
+                        h *= 0.5;
+                    }
                 }
-                if it <= 3 {
-                    h = (2.0 * h).min(spacing);
-                } else if it >= 7 {
-                    h *= 0.5;
+                Err(e) => {
+                    stats.cuts += 1;
+                    h = 0.5 * dh;
+                    if h >= h_min && !quick_fallback {
+                        continue;
+                    }
+                    // Snap-back (or a genuinely hard step): follow the path by dissipation. That
+                    // needs a loaded, dissipating state; without one no snap-back is possible and
+                    // the failure is genuine.
+                    if !(tau_hint > 0.0 && cur.reaction != 0.0 && cur.q[ic] != 0.0) {
+                        let msg = format!(
+                            "no convergence at control {:.6} ({e:?}) even with steps of {:.3e}, and nothing has \
+                             dissipated yet, so no snap-back to follow",
+                            dir * (pos + dh),
+                            dh
+                        );
+                        return Err(fail(rows, msg));
+                    }
+                    dissipating = true;
+                    if tau <= 0.0 || !quick_fallback {
+                        tau = tau_hint;
+                    }
+                    last = None;
                 }
             }
-            Err(e) => {
-                stats.cuts += 1;
-                h = 0.5 * dh;
-                if h >= h_min {
-                    continue;
+        } else {
+            let c0 = cur.q[ic];
+            let l0 = cur.reaction;
+            let mut lam = l0;
+            trial.copy_from_slice(&cur.q);
+            if let Some((dl_prev, tau_prev)) = last {
+                let beta = tau / tau_prev;
+                for i in 0..n {
+                    trial[i] += beta * (cur.q[i] - prev_q[i]);
                 }
-                // Snap-back (or a genuinely hard step): follow the path by dissipation. That needs
-                // a loaded, dissipating state; without one no snap-back is possible and the failure
-                // is genuine.
-                let blocked = pos + dh;
-                if !(tau_hint > 0.0 && cur.reaction != 0.0 && cur.q[ic] != 0.0) {
-                    let msg = format!(
-                        "no convergence at control {:.6} ({e:?}) even with steps of {:.3e}, and nothing has \
-                         dissipated yet, so no snap-back to follow",
-                        dir * blocked,
-                        dh
-                    );
-                    return Err(fail(rows, msg));
-                }
-                let mut tau = if tau_hint > 0.0 { tau_hint } else { 1e-3 * ledger.external_work.abs().max(1e-12) };
-                // Previous dissipation step (increment of the load factor and its τ) for the predictor.
-                let mut last: Option<(f64, f64)> = None;
-                let mut passed = false;
-                let mut dsteps = 0;
-                while dsteps < s.max_dissipation_steps {
-                    let c0 = cur.q[ic];
-                    let l0 = cur.reaction;
-                    let mut lam = l0;
-                    trial.copy_from_slice(&cur.q);
-                    if let Some((dl_prev, tau_prev)) = last {
-                        let beta = tau / tau_prev;
-                        for i in 0..n {
-                            trial[i] += beta * (cur.q[i] - prev_q[i]);
-                        }
-                        lam += beta * dl_prev;
+                lam += beta * dl_prev;
+            }
+            match nw.solve_dissipation(p, law, &cur.states, &mut trial, &mut lam, c0, l0, tau) {
+                Ok(it) => {
+                    commit!(lam);
+                    stats.dissipation_steps += 1;
+                    last = Some((lam - l0, tau));
+                    let dc = (cur.q[ic] - c0).abs();
+                    pos = dir * cur.q[ic];
+                    // Aim at steps of about half the output spacing in the control.
+                    if it <= 4 && dc > 0.0 {
+                        tau *= (0.5 * spacing / dc).clamp(0.5, 2.0);
+                    } else if it >= 7 {
+                        tau *= 0.6;
                     }
-                    match nw.solve_dissipation(p, law, &cur.states, &mut trial, &mut lam, c0, l0, tau) {
-                        Ok(it) => {
-                            commit!(lam);
-                            stats.dissipation_steps += 1;
-                            dsteps += 1;
-                            last = Some((lam - l0, tau));
-                            if dir * cur.q[ic] > blocked {
-                                passed = true;
-                                break;
-                            }
-                            if it <= 3 {
-                                tau *= 1.5;
-                            }
-                        }
-                        Err(_) => {
-                            stats.cuts += 1;
-                            tau *= 0.5;
-                            last = None;
-                            if tau < 1e-10 * ledger.external_work.abs().max(1e-300) {
-                                break;
-                            }
-                        }
+                    // Stay on dissipation control while the crack runs (each node that fails is a
+                    // small snap-back for displacement control); return to displacement control to
+                    // end exactly at the target, or when nothing dissipates any more.
+                    let near_end = pos + spacing >= target;
+                    if dir * (cur.q[ic] - c0) > 0.0 && (near_end || it == usize::MAX) {
+                        dissipating = false;
+                        quick_fallback = true;
+                        h = (0.5 * spacing).max(h_min);
+                        h_prev = 0.0;
                     }
                 }
-                if !passed {
-                    let msg = format!(
-                        "no convergence at control {:.6} after step cuts ({:?}) and {} dissipation-controlled steps",
-                        dir * blocked,
-                        e,
-                        dsteps
-                    );
-                    return Err(fail(rows, msg));
+                Err(_) => {
+                    stats.cuts += 1;
+                    tau *= 0.5;
+                    last = None;
+                    if tau < 1e-12 * ledger.external_work.abs().max(1e-300) {
+                        let msg = format!(
+                            "no convergence at control {:.6}: displacement control failed and the dissipation \
+                             constraint could not be met with increments down to {tau:.3e} N·mm",
+                            dir * pos
+                        );
+                        return Err(fail(rows, msg));
+                    }
                 }
-                // Resume displacement control from the current position.
-                pos = dir * cur.q[ic];
-                while k_out <= s.outputs && spacing * k_out as f64 <= pos {
-                    k_out += 1;
-                }
-                h = h_min.max(0.1 * spacing);
-                h_prev = 0.0;
             }
         }
     }
