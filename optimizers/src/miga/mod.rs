@@ -296,6 +296,10 @@ impl Optimizer for Miga {
             ));
         }
         let codec = self.codec(problem)?;
+        let fits = |i: &Individual| i.genes.len() == state.dim && i.genes.iter().all(|&g| g & !codec.mask() == 0);
+        if !state.islands.iter().flatten().all(fits) {
+            return Err(CzError::config("checkpoint", "state's chromosomes do not match `bits_per_gene`"));
+        }
         self.run(problem, budget, &codec, state, observer)
     }
 }
