@@ -6,6 +6,7 @@ use czid_problems::compare::{compare, CompareOptions};
 use czid_problems::identify::{identify, simulate, RunOptions};
 use czid_problems::output::OutputDir;
 use czid_problems::problem_file::LoadedProblem;
+use czid_problems::synthetic::TruthFile;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -53,6 +54,17 @@ enum Command {
         #[arg(long)]
         resume: bool,
     },
+    /// Make a synthetic test (CSV) from a truth file: a law, a model and a noise description.
+    Synthesize {
+        /// Truth file (TOML with [law], [model], [noise]).
+        truth: PathBuf,
+        /// CSV file to write (columns displacement_mm, load_N, debonded_length_mm).
+        #[arg(long)]
+        out: PathBuf,
+        /// Overwrite an existing file.
+        #[arg(long)]
+        force: bool,
+    },
     /// Compare optimizers over several seeds at equal budgets.
     Compare {
         /// Problem file (TOML).
@@ -93,6 +105,7 @@ fn main() -> ExitCode {
             let opts = RunOptions { optimizer, seed, budget, progress: true, resume, stop: Some(ctrl_c_flag()) };
             run_identify(&problem, &out, &opts)
         }
+        Command::Synthesize { truth, out, force } => run_synthesize(&truth, &out, force),
         Command::Compare { problem, optimizers, seeds, budget, target, out } => {
             run_compare(&problem, &out, &CompareOptions { optimizers, seeds, budget, target })
         }
@@ -140,6 +153,19 @@ fn run_identify(problem: &Path, out: &OutArgs, opts: &RunOptions) -> Result<(), 
         println!("warning: {w}");
     }
     println!("results, fits and plots in {}", dir.path().display());
+    Ok(())
+}
+
+fn run_synthesize(truth: &Path, out: &Path, force: bool) -> Result<(), CzError> {
+    if out.exists() && !force {
+        return Err(CzError::Io {
+            path: out.display().to_string(),
+            message: "exists; pass --force to overwrite".into(),
+        });
+    }
+    let data = TruthFile::read(truth)?.generate()?;
+    czid_problems::output::write_atomic(out, data.to_csv().as_bytes())?;
+    println!("{} synthetic readings written to {}", data.displacement.len(), out.display());
     Ok(())
 }
 

@@ -9,6 +9,7 @@
 //! * [`output`]: output folders that are never clobbered by accident, files written atomically.
 //! * [`plot`]: line plots (PNG/SVG) with a bundled font, written atomically.
 //! * [`problem_file`]: the TOML problem file (law, experiments, parameters, objective, optimizer).
+//! * [`synthetic`]: synthetic tests with documented noise, for studies with a known truth.
 
 pub mod compare;
 pub mod data;
@@ -18,3 +19,4 @@ pub mod identify;
 pub mod output;
 pub mod plot;
 pub mod problem_file;
+pub mod synthetic;
