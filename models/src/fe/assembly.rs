@@ -66,6 +66,7 @@ pub struct Assembler {
     pub gaps: Vec<Gap>,
     n: usize,
     strength: [f64; 2],
+    hess: Box<interface::Hessian>,
 }
 
 /// Relative margin within which a cohesive point iterates with its loading-branch tangent.
@@ -117,7 +118,15 @@ impl Assembler {
         let zero = LawEval { traction: Default::default(), tangent: Default::default(), state: LawState::default() };
         let st = law.strength();
         let strength = [st[0].abs().max(1e-300), st[1].abs().max(1e-300)];
-        Assembler { elements, linear, trial: vec![zero; np], gaps: vec![Gap::zeros(); np], n, strength }
+        Assembler {
+            elements,
+            linear,
+            trial: vec![zero; np],
+            gaps: vec![Gap::zeros(); np],
+            n,
+            strength,
+            hess: Box::new([[[0.0; 8]; 8]; 2]),
+        }
     }
 
     /// Internal forces `f` and tangent `k` at `q`, laws evaluated from the committed `states`.
@@ -152,7 +161,7 @@ impl Assembler {
         }
         let mut ok = true;
         for (ip, pt) in p.points.iter().enumerate() {
-            let kin = interface::kinematics(&p.mesh, pt, q, p.large_rotation);
+            let kin = interface::kinematics(&p.mesh, pt, q, p.large_rotation, &mut self.hess);
             let gap = Gap::new(kin.gap[0], kin.gap[1]);
             let (ev, d) = match pt.kind {
                 PointKind::Cohesive => {
@@ -194,7 +203,7 @@ impl Assembler {
                     }
                     let mut v = ra0 * g[0][b] + ra1 * g[1][b];
                     if kin.nonlinear {
-                        v += t[0] * kin.hess[0][a][b] + t[1] * kin.hess[1][a][b];
+                        v += t[0] * self.hess[0][a][b] + t[1] * self.hess[1][a][b];
                     }
                     if v != 0.0 {
                         k.add(da, db, w * v);

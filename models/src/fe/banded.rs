@@ -19,6 +19,9 @@ pub struct BandMatrix {
     bw: usize,
     width: usize,
     data: Vec<f64>,
+    /// Reciprocal pivots after factorisation (a triangular solve is a dependency chain; a multiply
+    /// is several times shorter than a divide on it).
+    inv_pivot: Vec<f64>,
 }
 
 /// Why a factorisation failed.
@@ -37,7 +40,7 @@ impl BandMatrix {
     /// A zero `n × n` matrix with half-bandwidth `bw`.
     pub fn zeros(n: usize, bw: usize) -> Self {
         let width = 2 * bw + 1;
-        BandMatrix { n, bw, width, data: vec![0.0; n * width] }
+        BandMatrix { n, bw, width, data: vec![0.0; n * width], inv_pivot: vec![0.0; n] }
     }
 
     /// Order of the matrix.
@@ -113,26 +116,71 @@ impl BandMatrix {
 
     /// In-place LU factorisation without pivoting (`L` unit lower, both kept in the band).
     pub fn factorize(&mut self) -> Result<(), BandError> {
+        // The common half-bandwidths get a fixed-size inner loop the compiler unrolls.
+        match self.bw {
+            3 => self.factorize_fixed::<3>(),
+            5 => self.factorize_fixed::<5>(),
+            7 => self.factorize_fixed::<7>(),
+            11 => self.factorize_fixed::<11>(),
+            _ => self.factorize_dyn(),
+        }
+    }
+
+    fn pivot_floor(&self) -> f64 {
         let (n, bw, w) = (self.n, self.bw, self.width);
-        // Scale for the pivot test: the largest diagonal magnitude.
         let mut scale = 0.0f64;
         for i in 0..n {
             scale = scale.max(self.data[i * w + bw].abs());
         }
-        let tiny = scale * 1e-14;
+        scale * 1e-14
+    }
+
+    fn factorize_fixed<const BW: usize>(&mut self) -> Result<(), BandError> {
+        let n = self.n;
+        let w = 2 * BW + 1;
+        let tiny = self.pivot_floor();
+        for k in 0..n {
+            let pivot = self.data[k * w + BW];
+            if !pivot.is_finite() || pivot.abs() <= tiny {
+                return Err(BandError::SingularPivot { row: k, value: pivot });
+            }
+            let inv = 1.0 / pivot;
+            self.inv_pivot[k] = inv;
+            let mut urow = [0.0; BW];
+            urow.copy_from_slice(&self.data[k * w + BW + 1..k * w + 2 * BW + 1]);
+            let rows = BW.min(n - 1 - k);
+            for r in 1..=rows {
+                let i = k + r;
+                let base = i * w + (BW - r);
+                let l = self.data[base] * inv;
+                self.data[base] = l;
+                if l != 0.0 {
+                    // Entries beyond column n − 1 are zero in the band, so the fixed loop is safe.
+                    let row = &mut self.data[base + 1..base + 1 + BW];
+                    for (a, u) in row.iter_mut().zip(&urow) {
+                        *a -= l * u;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn factorize_dyn(&mut self) -> Result<(), BandError> {
+        let (n, bw, w) = (self.n, self.bw, self.width);
+        let tiny = self.pivot_floor();
         for k in 0..n {
             let pivot = self.data[k * w + bw];
             if !pivot.is_finite() || pivot.abs() <= tiny {
                 return Err(BandError::SingularPivot { row: k, value: pivot });
             }
             let inv = 1.0 / pivot;
+            self.inv_pivot[k] = inv;
             let hi = (k + bw).min(n - 1);
             let (head, tail) = self.data.split_at_mut((k + 1) * w);
-            // Row k from column k+1 to hi.
             let urow = &head[k * w + bw + 1..k * w + bw + 1 + (hi - k)];
             for i in k + 1..=hi {
                 let row = &mut tail[(i - k - 1) * w..(i - k) * w];
-                // Column k of row i sits at offset k + bw - i.
                 let off = k + bw - i;
                 let l = row[off] * inv;
                 row[off] = l;
@@ -151,21 +199,43 @@ impl BandMatrix {
         let (n, bw, w) = (self.n, self.bw, self.width);
         for i in 0..n {
             let lo = i.saturating_sub(bw);
-            let row = &self.data[i * w..(i + 1) * w];
-            let mut s = b[i];
-            for j in lo..i {
-                s -= row[j + bw - i] * b[j];
-            }
-            b[i] = s;
+            let l = &self.data[i * w + lo + bw - i..i * w + bw];
+            let s: f64 = l.iter().zip(&b[lo..i]).map(|(a, x)| a * x).sum();
+            b[i] -= s;
         }
         for i in (0..n).rev() {
             let hi = (i + bw).min(n - 1);
-            let row = &self.data[i * w..(i + 1) * w];
-            let mut s = b[i];
-            for j in i + 1..=hi {
-                s -= row[j + bw - i] * b[j];
+            let u = &self.data[i * w + bw + 1..i * w + bw + 1 + (hi - i)];
+            let s: f64 = u.iter().zip(&b[i + 1..=hi]).map(|(a, x)| a * x).sum();
+            b[i] = (b[i] - s) * self.inv_pivot[i];
+        }
+    }
+
+    /// Solves `A x = b1` and `A y = b2` in place together: the two substitution chains are
+    /// independent, so interleaving them hides most of their latency.
+    pub fn solve2_in_place(&self, b1: &mut [f64], b2: &mut [f64]) {
+        let (n, bw, w) = (self.n, self.bw, self.width);
+        for i in 0..n {
+            let lo = i.saturating_sub(bw);
+            let l = &self.data[i * w + lo + bw - i..i * w + bw];
+            let (mut s1, mut s2) = (0.0, 0.0);
+            for ((a, x1), x2) in l.iter().zip(&b1[lo..i]).zip(&b2[lo..i]) {
+                s1 += a * x1;
+                s2 += a * x2;
             }
-            b[i] = s / row[bw];
+            b1[i] -= s1;
+            b2[i] -= s2;
+        }
+        for i in (0..n).rev() {
+            let hi = (i + bw).min(n - 1);
+            let u = &self.data[i * w + bw + 1..i * w + bw + 1 + (hi - i)];
+            let (mut s1, mut s2) = (0.0, 0.0);
+            for ((a, x1), x2) in u.iter().zip(&b1[i + 1..=hi]).zip(&b2[i + 1..=hi]) {
+                s1 += a * x1;
+                s2 += a * x2;
+            }
+            b1[i] = (b1[i] - s1) * self.inv_pivot[i];
+            b2[i] = (b2[i] - s2) * self.inv_pivot[i];
         }
     }
 }

@@ -60,11 +60,13 @@ pub struct GapKinematics {
     pub gap: [f64; 2],
     /// `∂g/∂q`.
     pub grad: [[f64; 8]; 2],
-    /// `∂²g/∂q²` (only with large rotations; zero otherwise).
-    pub hess: [[[f64; 8]; 8]; 2],
-    /// Whether `hess` is non-zero.
+    /// Whether the gap is nonlinear in the unknowns (large rotations: see [`Hessian`]).
     pub nonlinear: bool,
 }
+
+/// `∂²g/∂q²` of a point (large rotations only), kept out of [`GapKinematics`] so the
+/// small-rotation path never touches it.
+pub type Hessian = [[[f64; 8]; 8]; 2];
 
 #[inline]
 fn val(q: &[f64], d: usize) -> f64 {
@@ -87,6 +89,7 @@ fn surface(q: &[f64], dofs: &[usize; 4], z: f64, large: bool) -> Surface {
     let (u, w, t, s) = (val(q, dofs[0]), val(q, dofs[1]), val(q, dofs[2]), val(q, dofs[3]));
     let mut r = Surface { p: [0.0; 2], dp: [[0.0; 4]; 2], d2p: [[[0.0; 4]; 4]; 2] };
     if large {
+        // (d2p stays zero with small rotations)
         let (sn, cs) = t.sin_cos();
         let ze = z + s;
         r.p = [u - ze * sn, w + ze * cs - z];
@@ -106,9 +109,12 @@ fn surface(q: &[f64], dofs: &[usize; 4], z: f64, large: bool) -> Surface {
     r
 }
 
-/// Gap kinematics of point `p` at unknowns `q`.
-pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool) -> GapKinematics {
+/// Gap kinematics of point `p` at unknowns `q`; with `large`, also the Hessians into `hess`.
+pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess: &mut Hessian) -> GapKinematics {
     let mut k = GapKinematics { dofs: [NONE; 8], ..Default::default() };
+    if large {
+        *hess = [[[0.0; 8]; 8]; 2];
+    }
     let du = mesh.dofs(p.upper, p.node);
     k.dofs[4..8].copy_from_slice(&du);
     let su = surface(q, &du, -0.5 * mesh.layers[p.upper].section.h, large);
@@ -117,8 +123,10 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool) -> Ga
         k.gap[0] = 2.0 * su.p[1];
         for j in 0..4 {
             k.grad[0][4 + j] = 2.0 * su.dp[1][j];
-            for m in 0..4 {
-                k.hess[0][4 + j][4 + m] = 2.0 * su.d2p[1][j][m];
+            if large {
+                for m in 0..4 {
+                    hess[0][4 + j][4 + m] = 2.0 * su.d2p[1][j][m];
+                }
             }
         }
         k.nonlinear = large;
@@ -163,16 +171,16 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool) -> Ga
         for b in 0..4 {
             for (off, side, sign) in [(0usize, &sl, -1.0), (4usize, &su, 1.0)] {
                 let (vx, vy) = (sign * side.d2p[0][a][b], sign * side.d2p[1][a][b]);
-                k.hess[0][off + a][off + b] += n[0] * vx + n[1] * vy;
-                k.hess[1][off + a][off + b] += t[0] * vx + t[1] * vy;
+                hess[0][off + a][off + b] += n[0] * vx + n[1] * vy;
+                hess[1][off + a][off + b] += t[0] * vx + t[1] * vy;
             }
         }
     }
     // ∂²n/∂θ̄² = −n, ∂²t/∂θ̄² = −t
     for i in 0..8 {
         for j in 0..8 {
-            k.hess[0][i][j] += -td[i] * dtb[j] - dtb[i] * td[j] - gn * dtb[i] * dtb[j];
-            k.hess[1][i][j] += nd[i] * dtb[j] + dtb[i] * nd[j] - gt * dtb[i] * dtb[j];
+            hess[0][i][j] += -td[i] * dtb[j] - dtb[i] * td[j] - gn * dtb[i] * dtb[j];
+            hess[1][i][j] += nd[i] * dtb[j] + dtb[i] * nd[j] - gt * dtb[i] * dtb[j];
         }
     }
     k.nonlinear = true;

@@ -207,10 +207,9 @@ impl Newton {
             }
             self.counters.1 += 1;
             self.k.factorize().map_err(|_| StepFailure::Singular)?;
-            self.k.solve_in_place(&mut self.r);
             self.b.fill(0.0);
             self.b[ic] = 1.0;
-            self.k.solve_in_place(&mut self.b);
+            self.k.solve2_in_place(&mut self.r, &mut self.b);
             // Bordering: Δq = a + Δλ b, with the constraint linearised in (c, λ).
             let den = 0.5 * lambda0 * self.b[ic] - 0.5 * c0;
             if den == 0.0 || !den.is_finite() {

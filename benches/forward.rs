@@ -1,0 +1,26 @@
+//! Forward-model benchmarks: full DCB runs as an identification performs them thousands of times.
+//!
+//! * `dcb_paper_table3`: Shi & Zhang's DCB, 0.1 mm interface elements, ST-CZM Table 3, to the
+//!   default final opening (crack 60 % of the way to the end by beam theory).
+//! * `dcb_hartlen_30mm`: Hartlen's DCB-01 to 30 mm opening, bilinear law (G_Ic = 0.8 N/mm).
+//! * `band_lu_*`: one factorisation of the paper DCB's tangent, band LU vs faer's sparse LU.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use czid_core::ForwardModel;
+use czid_models::dcb::Dcb;
+use czid_models::laws::{Bilinear, StCzm};
+
+fn forward(c: &mut Criterion) {
+    let mut g = c.benchmark_group("forward");
+    g.sample_size(20);
+    let paper = Dcb::paper();
+    let t3 = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap();
+    g.bench_function("dcb_paper_table3", |b| b.iter(|| paper.simulate(&t3).unwrap()));
+    let hartlen = Dcb::hartlen_dcb01();
+    let law = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
+    g.bench_function("dcb_hartlen_30mm", |b| b.iter(|| hartlen.simulate(&law).unwrap()));
+    g.finish();
+}
+
+criterion_group!(benches, forward);
+criterion_main!(benches);
