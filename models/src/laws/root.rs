@@ -11,7 +11,8 @@ const MAX_ITERATIONS: usize = 200;
 /// Finds the root of `f` in `[lo, hi]`, where `f` is monotone with a sign change on the bracket.
 ///
 /// `f` returns `(value, derivative)`; `increasing` says which way it goes; `start` is the first
-/// iterate (clamped into the bracket). Converges to a few ulps of the root.
+/// iterate (clamped into the bracket). Stops once a step is below 1e-14 of the root (or the
+/// bracket is that narrow).
 pub(crate) fn solve_monotone(
     mut f: impl FnMut(f64) -> (f64, f64),
     mut lo: f64,
@@ -32,9 +33,14 @@ pub(crate) fn solve_monotone(
             hi = x;
         }
         let newton = x - value / slope;
+        // 1e-14 relative: the residuals carry roundoff of a few ulps of their terms, so asking for
+        // the last ulp would chase noise (and a noisy sign must not trigger a bisection step).
+        let tolerance = 1e-14 * x.abs().max(f64::MIN_POSITIVE);
+        if (newton - x).abs() <= tolerance {
+            return newton.clamp(lo, hi);
+        }
         let next = if newton.is_finite() && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
-        let tolerance = 4.0 * f64::EPSILON * next.abs().max(f64::MIN_POSITIVE);
-        if (next - x).abs() <= tolerance || hi - lo <= tolerance {
+        if hi - lo <= tolerance {
             return next;
         }
         x = next;

@@ -34,6 +34,10 @@ const OWNER: &str = "law st_czm";
 /// The initial stiffness is `k_m = σ_m / u_e,m` (the tables' `k_i,0`: 27 / 0.00027 = 1e5 MPa/mm),
 /// and with the sawtooth shape the pure-mode toughness is `G_m = ½ σ_m u_c,m`.
 ///
+/// State: `damage` is the shared D; `history[0]` and `history[1]` cache the per-mode openings
+/// `δ_n(D)`, `δ_t(D)` of the committed damage (zero means "not known yet": they are recomputed,
+/// so a state built by hand with only `damage` set is fine).
+///
 /// ```
 /// use czid_core::{CohesiveLaw, Gap, LawState};
 /// use czid_models::laws::StCzm;
@@ -107,10 +111,10 @@ impl StCzm {
     }
 
     /// Intact fraction `1 − D` on the failure surface through `(a_n, a_t)` (opening ⟨u_n⟩ and
-    /// slip), in `(0, intact_old)`. The caller guarantees the point lies strictly between the
+    /// slip), in `(0, intact_old)`, with the per-mode openings there; `guesses` are nearby openings. The caller guarantees the point lies strictly between the
     /// surface of the committed damage and the complete-failure ellipse, so exactly one root exists.
     /// Solving for `1 − D` rather than `D` keeps the traction's digits near separation.
-    fn intact_on_surface(&self, a_n: f64, a_t: f64, intact_old: f64) -> f64 {
+    fn intact_on_surface(&self, a_n: f64, a_t: f64, intact_old: f64, guesses: (f64, f64)) -> (f64, (f64, f64)) {
         let (mode_n, mode_t) = (self.mode_n(), self.mode_t());
         if self.shape_n == StrengthShape::Sawtooth && self.shape_t == StrengthShape::Sawtooth {
             // δ_m = u_e,m / (p_m + c_m I), p_m = u_e,m/u_c,m, c_m = 1 − p_m, I = 1 − D, turns g = 0 into
@@ -125,18 +129,34 @@ impl StCzm {
             let half_linear = an2 * cn * pn + at2 * ct * pt;
             let constant = an2 * pn * pn + at2 * pt * pt - 1.0;
             let discriminant = half_linear * half_linear - quadratic * constant;
-            let root = -constant / (half_linear + discriminant.sqrt());
-            return root.clamp(0.0, intact_old);
+            let intact = (-constant / (half_linear + discriminant.sqrt())).clamp(0.0, intact_old);
+            return (intact, (mode_n.opening_at_intact(intact), mode_t.opening_at_intact(intact)));
         }
         // g grows with I (the per-mode openings shrink): negative at I = 0, positive at intact_old.
+        // Each iterate's openings seed the next iterate's inverse.
+        let (mut guess_n, mut guess_t) = guesses;
         let residual = |intact: f64| {
-            let (dn, dt) = (mode_n.opening_at_intact(intact), mode_t.opening_at_intact(intact));
+            let (dn, dt) =
+                (mode_n.opening_at_intact_near(intact, guess_n), mode_t.opening_at_intact_near(intact, guess_t));
+            (guess_n, guess_t) = (dn, dt);
             let g = (a_n / dn).powi(2) + (a_t / dt).powi(2) - 1.0;
             let dg = 2.0
                 * (a_n * a_n * mode_n.opening_rate(dn) / dn.powi(3) + a_t * a_t * mode_t.opening_rate(dt) / dt.powi(3));
             (g, dg)
         };
-        solve_monotone(residual, 0.0, intact_old, intact_old, true)
+        let intact = solve_monotone(residual, 0.0, intact_old, intact_old, true);
+        (intact, (guess_n, guess_t))
+    }
+
+    /// The per-mode openings `δ_m` at the committed damage: cached in `history[0..2]` by earlier
+    /// evaluations (the inverse of an exponential strength model is iterative), else computed.
+    fn committed_openings(&self, previous: &LawState, intact_old: f64) -> (f64, f64) {
+        let [dn, dt, _] = previous.history;
+        if dn > 0.0 && dt > 0.0 {
+            (dn, dt)
+        } else {
+            (self.mode_n().opening_at_intact(intact_old), self.mode_t().opening_at_intact(intact_old))
+        }
     }
 }
 
@@ -151,29 +171,29 @@ impl CohesiveLaw for StCzm {
         let stiffness = self.stiffness();
         let damage_old = previous.damage.clamp(0.0, 1.0);
         let (a_n, a_t) = (opening(gap), gap.y);
-        let respond = |intact: f64| {
+        let respond = |intact: f64, openings: [f64; 2]| {
             let (traction, tangent) = secant(stiffness, intact, gap);
-            LawEval { traction, tangent, state: LawState { damage: 1.0 - intact, history: previous.history } }
+            let history = [openings[0], openings[1], previous.history[2]];
+            LawEval { traction, tangent, state: LawState { damage: 1.0 - intact, history } }
         };
-        if damage_old >= 1.0 || (a_n == 0.0 && a_t == 0.0) {
-            return respond(1.0 - damage_old);
+        if damage_old >= 1.0 {
+            return respond(0.0, [self.u_c_n, self.u_c_t]);
         }
-        if (a_n / self.u_c_n).powi(2) + (a_t / self.u_c_t).powi(2) >= 1.0 {
-            return respond(0.0);
-        }
-        let (mode_n, mode_t) = (self.mode_n(), self.mode_t());
         let intact_old = 1.0 - damage_old;
-        let (dn_old, dt_old) = (mode_n.opening_at_intact(intact_old), mode_t.opening_at_intact(intact_old));
-        if (a_n / dn_old).powi(2) + (a_t / dt_old).powi(2) <= 1.0 {
-            // Inside the current surface: elastic on the damaged secant (unloading or reloading).
-            return respond(intact_old);
+        let (dn_old, dt_old) = self.committed_openings(previous, intact_old);
+        if (a_n / self.u_c_n).powi(2) + (a_t / self.u_c_t).powi(2) >= 1.0 {
+            return respond(0.0, [self.u_c_n, self.u_c_t]);
         }
-        let intact = self.intact_on_surface(a_n, a_t, intact_old);
-        let (dn, dt) = (mode_n.opening_at_intact(intact), mode_t.opening_at_intact(intact));
+        if (a_n / dn_old).powi(2) + (a_t / dt_old).powi(2) <= 1.0 {
+            // Inside the current surface (or at the origin): elastic on the damaged secant.
+            return respond(intact_old, [dn_old, dt_old]);
+        }
+        let (intact, (dn, dt)) = self.intact_on_surface(a_n, a_t, intact_old, (dn_old, dt_old));
+        let (mode_n, mode_t) = (self.mode_n(), self.mode_t());
         // ∂D/∂u = −g_u/g_D from g(u, D(u)) = 0, with g_D = −2 Σ a_m² δ_m'/δ_m³ and δ' = dδ/dD.
         let g_d = a_n * a_n * mode_n.opening_rate(dn) / dn.powi(3) + a_t * a_t * mode_t.opening_rate(dt) / dt.powi(3);
         let gradient = [a_n / (dn * dn) / g_d, a_t / (dt * dt) / g_d];
-        let mut eval = respond(intact);
+        let mut eval = respond(intact, [dn, dt]);
         add_damage_growth(&mut eval.tangent, stiffness, gap, gradient);
         eval
     }

@@ -167,6 +167,12 @@ impl ModeStrength {
     /// [`ModeStrength::opening_at_damage`] in terms of the intact fraction `1 − D`, which keeps its
     /// digits near separation where `D` itself rounds to 1.
     pub fn opening_at_intact(&self, intact: f64) -> f64 {
+        self.opening_at_intact_near(intact, self.u_e)
+    }
+
+    /// [`ModeStrength::opening_at_intact`] with a first guess for the shapes that need an
+    /// iterative inverse (exponential): a nearby earlier solution cuts the Newton steps to one or two.
+    pub(crate) fn opening_at_intact_near(&self, intact: f64, guess: f64) -> f64 {
         if intact >= 1.0 {
             return self.u_e;
         }
@@ -188,14 +194,32 @@ impl ModeStrength {
                 let a = s - b * piece_at;
                 self.u_e * a / (intact - self.u_e * b)
             }
-            StrengthShape::Exponential { .. } => {
-                // (1 − D)δ − u_e s(δ) increases from −D u_e at u_e to (1 − D) u_c at u_c; it is concave
-                // (s is convex), so Newton from the left approaches monotonically; bisection guards it.
-                let residual = |opening: f64| {
-                    let (s, slope) = self.normalized_strength(opening);
-                    (intact * opening - self.u_e * s, intact - self.u_e * slope)
+            StrengthShape::Exponential { alpha } => {
+                // With t = e^{−αx} the strength is linear, s = (t − e^{−α}) / (1 − e^{−α}), and the secant
+                // condition (1 − D)δ = u_e s reads F(t) = I (u_e − (L/α) ln t) − u_e s(t) = 0 on
+                // [e^{−α}, 1]: decreasing and convex with curvature only from I (L/α) ln t, which is
+                // mild for any α, so Newton needs two or three steps. One Newton step on the residual
+                // in δ then restores the last digits lost to t's narrow range when α is small.
+                let span = self.u_c - self.u_e;
+                let floor = (-alpha).exp();
+                let range = -(-alpha).exp_m1();
+                let scale = span / alpha;
+                let residual_t = |t: f64| {
+                    (
+                        intact * (self.u_e - scale * t.ln()) - self.u_e * (t - floor) / range,
+                        -intact * scale / t - self.u_e / range,
+                    )
                 };
-                solve_monotone(residual, self.u_e, self.u_c, self.u_e, true)
+                let start = (-alpha * (guess - self.u_e) / span).exp();
+                let t = solve_monotone(residual_t, floor, 1.0, start, false);
+                let opening = (self.u_e - scale * t.ln()).clamp(self.u_e, self.u_c);
+                let (s, slope) = self.normalized_strength(opening);
+                let polished = opening - (intact * opening - self.u_e * s) / (intact - self.u_e * slope);
+                if polished.is_finite() {
+                    polished.clamp(self.u_e, self.u_c)
+                } else {
+                    opening
+                }
             }
         }
     }
