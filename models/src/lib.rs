@@ -6,5 +6,6 @@
 pub mod beamtest;
 pub mod dcb;
 pub mod effects;
+pub mod enf;
 pub mod fe;
 pub mod laws;

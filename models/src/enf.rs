@@ -1,0 +1,223 @@
+//! End-notched flexure (ENF, mode II) on the beam/interface engine.
+//!
+//! Three-point bending of a beam made of two equal layers: supports under the lower layer at
+//! `x = 0` and `x = 2L`, the load on the upper layer at mid-span `x = L`. A mid-plane crack runs
+//! from the left support to `x = a0`; beyond it the layers are joined by the cohesive law. On the
+//! cracked faces a frictionless normal contact penalty keeps the arms from interpenetrating (the
+//! arms press on each other there); its stiffness defaults to the law's normal penalty. The
+//! applied displacement is the load-point deflection (positive downwards) and the load the
+//! force at the loading nose.
+//!
+//! ENF specimens with `a0 / L < 0.7` propagate unstably under displacement control: the path
+//! follower then switches to dissipation control and records the snap-back.
+
+use czid_core::{CohesiveLaw, CzError, ForwardModel, Record, Result, SimulationFailure};
+use serde::{Deserialize, Serialize};
+
+use crate::beamtest::{self, ControlSettings, Material, MeshSettings, RowScale};
+use crate::effects::Effects;
+use crate::fe::mesh::{graded, NONE};
+use crate::fe::{
+    self, FeProblem, InterfacePoint, Layer, Mesh, NewtonSettings, PathSettings, PointKind, Section, Spring,
+};
+
+/// ENF configuration. All lengths in mm, moduli in MPa.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Enf {
+    /// Initial crack length from the left support to the crack front (mm).
+    pub a0: f64,
+    /// Half-span L between a support and the loading nose (mm).
+    pub half_span: f64,
+    /// Width b (mm).
+    pub width: f64,
+    /// Thickness of each arm h (mm) (the beam is 2h thick).
+    pub h: f64,
+    /// Adherend constants.
+    pub material: Material,
+    /// Normal penalty of the contact on the cracked faces (MPa/mm); `None`: the law's normal
+    /// initial stiffness.
+    #[serde(default)]
+    pub contact_stiffness: Option<f64>,
+    /// Element sizes (`interface_element` from the crack front to the loading nose, where the
+    /// crack runs; `arm_element` elsewhere).
+    #[serde(default)]
+    pub mesh: MeshSettings,
+    /// Loading and output; `control.max_displacement` is the final load-point deflection (mm),
+    /// by default twice the beam-theory deflection at the onset of propagation.
+    #[serde(default)]
+    pub control: ControlSettings,
+    /// Optional physics (all off by default; `large_rotation` is not supported for ENF).
+    #[serde(default)]
+    pub effects: Effects,
+}
+
+const OWNER: &str = "model enf";
+
+impl Enf {
+    /// Hartlen's ENF-03 specimen (h = 2.7 mm per arm, b = 25, L = 50, a0 = 34.7 mm; E_L = 19.3,
+    /// E_T = 6.11, G_LT = 2.288 GPa).
+    pub fn hartlen_enf03() -> Self {
+        Enf {
+            a0: 34.7,
+            half_span: 50.0,
+            width: 25.0,
+            h: 2.7,
+            material: Material { e11: 19_300.0, e22: 6_110.0, g13: 2_288.0, nu13: 0.0, plane: Default::default() },
+            contact_stiffness: None,
+            mesh: MeshSettings { interface_element: 0.2, arm_element: 1.0 },
+            control: ControlSettings::default(),
+            effects: Effects::default(),
+        }
+    }
+
+    /// Checks the configuration, naming the first invalid field.
+    pub fn validate(&self) -> Result<()> {
+        beamtest::positive(OWNER, "a0", self.a0)?;
+        beamtest::positive(OWNER, "half_span", self.half_span)?;
+        beamtest::positive(OWNER, "width", self.width)?;
+        beamtest::positive(OWNER, "h", self.h)?;
+        if let Some(k) = self.contact_stiffness {
+            beamtest::positive(OWNER, "contact_stiffness", k)?;
+        }
+        self.material.validate(OWNER)?;
+        self.mesh.validate(OWNER)?;
+        self.control.validate(OWNER)?;
+        self.effects.validate(OWNER)?;
+        if self.effects.large_rotation {
+            return Err(CzError::invalid(OWNER, "effects.large_rotation", 1.0, "is not supported by the ENF model"));
+        }
+        let a = self.effective_crack_length();
+        if !(a > 0.0 && a < self.half_span) {
+            return Err(CzError::invalid(
+                OWNER,
+                "a0",
+                self.a0,
+                format!("the crack front a0 + effects.crack_length_offset = {a} must lie in (0, half_span)"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Crack length the mesh uses: `a0 + effects.crack_length_offset` (mm).
+    pub fn effective_crack_length(&self) -> f64 {
+        self.a0 + self.effects.crack_length_offset
+    }
+
+    fn section(&self) -> Section {
+        Section { e: self.material.axial_modulus(), g: self.material.g13, b: self.width, h: self.h }
+    }
+
+    /// Beam-theory compliance with shear, `C = (3a³ + 2L³)/(8 E b h³) + 3L/(10 G13 b h)` (mm/N).
+    pub fn beam_compliance(&self, a: f64) -> f64 {
+        let (e, g, b, h, l) = (self.material.axial_modulus(), self.material.g13, self.width, self.h, self.half_span);
+        (3.0 * a.powi(3) + 2.0 * l.powi(3)) / (8.0 * e * b * h.powi(3)) + 3.0 * l / (10.0 * g * b * h)
+    }
+
+    /// Final deflection: configured, or twice the beam-theory deflection at which the crack
+    /// starts, `P_c = (4b/(3a)) √(E h³ G_IIc)`.
+    pub fn max_deflection(&self, law: &dyn CohesiveLaw) -> f64 {
+        if let Some(d) = self.control.max_displacement {
+            return d;
+        }
+        let a = self.effective_crack_length();
+        let e = self.material.axial_modulus();
+        let pc = 4.0 * self.width / (3.0 * a) * (e * self.h.powi(3) * law.fracture_energy()[1].max(1e-12)).sqrt();
+        2.0 * self.beam_compliance(a) * pc
+    }
+
+    /// Builds the discrete problem (built per run, like the DCB's).
+    pub fn problem(&self, law: &dyn CohesiveLaw) -> Result<(FeProblem, RowScale)> {
+        self.validate()?;
+        let fx = &self.effects;
+        let a = self.effective_crack_length();
+        let l = self.half_span;
+        let (fine, coarse) = (self.mesh.interface_element, self.mesh.arm_element);
+        let x = graded(&[0.0, a, l, 2.0 * l], &[coarse.min(4.0 * fine), fine, coarse.min(4.0 * fine)]);
+        let nn = x.len();
+        let tip = x.iter().position(|&v| (v - a).abs() <= 1e-9 * l).unwrap_or(0);
+        let mid = x.iter().position(|&v| (v - l).abs() <= 1e-9 * l).unwrap_or(nn / 2);
+        let surface = (fx.root_compliance > 0.0).then_some((tip, nn - 1));
+        let s = self.section();
+        let lo = Layer { section: s, y: 0.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
+        let up = Layer { section: s, y: 1.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
+        let machine = fx.machine_compliance > 0.0;
+        let mesh = Mesh::new(x, vec![lo, up], usize::from(machine))?;
+        let mut points = Vec::with_capacity(nn + 1);
+        let mut springs = Vec::new();
+        for i in 0..nn {
+            let left = if i > 0 { 0.5 * (mesh.x[i] - mesh.x[i - 1]) } else { 0.0 };
+            let right = if i + 1 < nn { 0.5 * (mesh.x[i + 1] - mesh.x[i]) } else { 0.0 };
+            let pt = |area: f64, kind| InterfacePoint { node: i, upper: 1, lower: Some(0), area, factor: 1.0, kind };
+            if i < tip {
+                points.push(pt(self.width * (left + right), PointKind::Contact));
+            } else if i == tip {
+                points.push(pt(self.width * left, PointKind::Contact));
+                points.push(pt(self.width * right, PointKind::Cohesive));
+            } else {
+                points.push(pt(self.width * (left + right), PointKind::Cohesive));
+            }
+            if fx.root_compliance > 0.0 && i >= tip {
+                let area = self.width * (if i == tip { right } else { left + right });
+                for layer in 0..2 {
+                    springs.push(Spring { i: mesh.dofs(layer, i)[3], j: NONE, k: area / fx.root_compliance, ci: 1.0 });
+                }
+            }
+        }
+        let fixed = vec![mesh.dofs(0, 0)[1], mesh.dofs(0, nn - 1)[1], mesh.dofs(0, nn - 1)[0]];
+        let w_load = mesh.dofs(1, mid)[1];
+        let (control, scale) = if machine {
+            // Actuator `a` (crosshead travel, downwards) behind the machine spring: elongation a + w.
+            springs.push(Spring { i: w_load, j: 0, k: 1.0 / fx.machine_compliance, ci: -1.0 });
+            (0, RowScale { displacement: 1.0, offset: fx.displacement_offset, load: 1.0, energy: 1.0 })
+        } else {
+            (w_load, RowScale { displacement: -1.0, offset: fx.displacement_offset, load: -1.0, energy: 1.0 })
+        };
+        let contact_stiffness = self.contact_stiffness.unwrap_or(law.initial_stiffness()[0]);
+        let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: false, contact_stiffness };
+        Ok((p, scale))
+    }
+
+    fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
+        PathSettings {
+            target: self.max_deflection(law) / scale.displacement,
+            outputs: self.control.output_points,
+            min_step_fraction: 1e-3,
+            max_dissipation_steps: 2000,
+            damage_threshold: self.control.damage_threshold,
+            crack_origin: self.effective_crack_length(),
+            newton: NewtonSettings { max_iterations: self.control.max_iterations, tolerance: self.control.tolerance },
+        }
+    }
+}
+
+#[typetag::serde(name = "enf")]
+impl ForwardModel for Enf {
+    fn name(&self) -> &str {
+        "enf"
+    }
+
+    fn validate(&self) -> Result<()> {
+        Enf::validate(self)
+    }
+
+    fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
+        let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
+        law.validate().map_err(fail)?;
+        let (p, scale) = self.problem(law).map_err(fail)?;
+        let path = self.path(law, &scale);
+        match fe::run(&p, law, &path) {
+            Ok((rows, _)) => Ok(beamtest::to_record(&rows, &scale)),
+            Err(f) => Err(SimulationFailure { error: f.error, partial: beamtest::to_record(&f.rows, &scale) }),
+        }
+    }
+}
+
+/// Runs `enf` and also returns the engine's statistics.
+pub fn simulate_with_stats(enf: &Enf, law: &dyn CohesiveLaw) -> Result<(Record, fe::RunStats)> {
+    law.validate()?;
+    let (p, scale) = enf.problem(law)?;
+    let path = enf.path(law, &scale);
+    let (rows, stats) = fe::run(&p, law, &path).map_err(|f| f.error)?;
+    Ok((beamtest::to_record(&rows, &scale), stats))
+}

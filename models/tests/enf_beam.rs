@@ -1,0 +1,68 @@
+//! ENF: linear-branch compliance against beam theory with shear, and a run on a real specimen
+//! geometry through the peak.
+//!
+//! Beam theory (h arm thickness, L half-span, a crack length, frictionless arms in the cracked
+//! part, perfect bond beyond): bending C_b = (3a³ + 2L³)/(8 E b h³); shear: each half-span carries
+//! P/2 on the whole section 2bh with κ = 5/6, so the mid-span shear deflection is
+//! (P/2) L/(κ G 2bh) = 3PL/(10 G b h). C = C_b + 3L/(10 G b h).
+
+mod fe_support;
+use czid_core::{columns, ForwardModel, Record};
+use czid_models::enf::{self, Enf};
+use czid_models::laws::Bilinear;
+use fe_support::{interp, TestBilinear};
+
+fn col<'a>(r: &'a Record, c: &str) -> &'a [f64] {
+    r.column(c).unwrap()
+}
+
+#[test]
+fn linear_branch_compliance_matches_beam_theory_with_shear() {
+    let mut e = Enf::hartlen_enf03();
+    e.control.max_displacement = Some(0.5);
+    e.control.output_points = 2;
+    e.mesh.interface_element = 0.25;
+    // Elastic, stiff interface (beam theory assumes a perfect bond).
+    let law = TestBilinear::new(1e7, 1e6, 1e6);
+    let rec = e.simulate(&law).unwrap_or_else(|f| panic!("{}", f.error));
+    let (x, p) = (col(&rec, columns::DISPLACEMENT), col(&rec, columns::LOAD));
+    let c = x.last().unwrap() / p.last().unwrap();
+    let (eb, g, b, h, l, a) = (19_300.0, 2_288.0, 25.0, 2.7, 50.0, 34.7);
+    let reference = (3.0 * a * a * a + 2.0 * l * l * l) / (8.0 * eb * b * h * h * h) + 3.0 * l / (10.0 * g * b * h);
+    let err = c / reference - 1.0;
+    println!("ENF compliance {c:.6e} mm/N, beam theory with shear {reference:.6e} ({:+.3} %)", 100.0 * err);
+    assert!(err.abs() < 0.01, "{err}");
+    assert!((e.beam_compliance(a) / reference - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn hartlen_enf_runs_past_the_peak() {
+    let mut e = Enf::hartlen_enf03();
+    e.control.output_points = 40;
+    e.mesh.interface_element = 0.25;
+    // A plausible mode II law for this glass/epoxy (not fitted): G_IIc = 3.5 N/mm, 60 MPa.
+    let law = Bilinear::bk(1e5, 40.0, 60.0, 1.0, 3.5, 2.0).unwrap();
+    let t = std::time::Instant::now();
+    let (rec, stats) = enf::simulate_with_stats(&e, &law).unwrap();
+    let (x, p, tip) = (col(&rec, columns::DISPLACEMENT), col(&rec, columns::LOAD), col(&rec, columns::CRACK_TIP));
+    // The propagation peak: the largest load before the crack has grown 2 mm (once the crack
+    // passes under the loading nose the two arms carry the load and it rises again).
+    let growth = tip.iter().position(|t| *t > 34.7 + 2.0).expect("the crack grows");
+    let (ipk, peak) = p[..growth].iter().enumerate().fold((0, 0.0f64), |m, (i, v)| if *v > m.1 { (i, *v) } else { m });
+    let trough = p[ipk..].iter().fold(f64::INFINITY, |m, v| m.min(*v));
+    let last = rec.rows() - 1;
+    println!(
+        "Hartlen ENF: peak {peak:.1} N at {:.3} mm, final {:.3} mm / {:.1} N, tip {:.1} mm; {stats:?} in {:?}",
+        x[ipk],
+        x[last],
+        p[last],
+        tip[last],
+        t.elapsed()
+    );
+    for i in (0..rec.rows()).step_by(4) {
+        println!("  {:.3} {:.1} {:.2} pz {:.2}", x[i], p[i], tip[i], col(&rec, columns::PROCESS_ZONE_LENGTH)[i]);
+    }
+    assert!(trough < 0.9 * peak, "ran past the peak (lowest load after it {trough})");
+    assert!(tip[last] > 40.0, "the crack ran towards the loading nose");
+    let _ = interp(x, p, 0.5 * x[ipk]);
+}
