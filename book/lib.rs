@@ -7,3 +7,5 @@ pub mod introduction {}
 pub mod concepts {}
 #[doc = include_str!("src/optimizers.md")]
 pub mod optimizers {}
+#[doc = include_str!("src/problem_files.md")]
+pub mod problem_files {}

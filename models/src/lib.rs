@@ -9,3 +9,4 @@ pub mod effects;
 pub mod enf;
 pub mod fe;
 pub mod laws;
+pub mod registry;

@@ -169,6 +169,7 @@ impl LoadedProblem {
 
     /// Parses problem-file text; `path` locates relative data files and names errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        czid_models::registry::ensure_linked();
         let shown = path.display().to_string();
         let file: ProblemFile = toml::from_str(text).map_err(|e| CzError::config(&shown, e.to_string().trim_end()))?;
         file.law.validate().map_err(|e| CzError::config(format!("{shown}, [law]"), e.to_string()))?;

@@ -151,6 +151,7 @@ pub struct NoiseSpec {
 impl TruthFile {
     /// Reads and validates a truth file.
     pub fn read(path: &std::path::Path) -> Result<Self> {
+        czid_models::registry::ensure_linked();
         let shown = path.display().to_string();
         let text =
             std::fs::read_to_string(path).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
