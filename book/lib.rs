@@ -5,6 +5,10 @@
 pub mod introduction {}
 #[doc = include_str!("src/concepts.md")]
 pub mod concepts {}
+#[doc = include_str!("src/laws.md")]
+pub mod laws {}
+#[doc = include_str!("src/custom_law.md")]
+pub mod custom_law {}
 #[doc = include_str!("src/optimizers.md")]
 pub mod optimizers {}
 #[doc = include_str!("src/problem_files.md")]
