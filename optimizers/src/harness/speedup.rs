@@ -55,18 +55,25 @@ impl Problem for Costly {
 
 /// Measures the speed-up of `evaluations` evaluations costing `cost_seconds` each.
 pub fn measure_speedup(cost_seconds: f64, evaluations: usize, threads: usize) -> Result<SpeedupReport> {
-    // Calibrate the work per evaluation on this machine.
+    // Calibrate the work per evaluation on this machine; the fastest of several probes is
+    // the uncontended cost (a slow probe would make every evaluation too cheap).
     let probe = 200_000u64;
-    let t = Instant::now();
-    black_box(burn(probe));
-    let per_iteration = t.elapsed().as_secs_f64() / probe as f64;
+    let per_iteration = (0..5)
+        .map(|_| {
+            let t = Instant::now();
+            black_box(burn(probe));
+            t.elapsed().as_secs_f64() / probe as f64
+        })
+        .fold(f64::INFINITY, f64::min);
     let work = (cost_seconds / per_iteration).ceil() as u64;
     let problem = Costly { work };
-    let t = Instant::now();
-    for _ in 0..10 {
-        black_box(problem.evaluate(&[0.0; 10])?);
-    }
-    let evaluation_seconds = t.elapsed().as_secs_f64() / 10.0;
+    let evaluation_seconds = (0..5)
+        .map(|_| {
+            let t = Instant::now();
+            black_box(burn(work));
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min);
 
     let miga = Miga::new(MigaSettings::default())?;
     let budget = Budget::evaluations(evaluations);
