@@ -165,6 +165,9 @@ pub fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Ve
     let mut quick_fallback = false;
     let mut tau = 0.0f64;
     let mut last: Option<(f64, f64)> = None;
+    // Control increment of the last dissipation step that moved forward (0: none).
+    let mut dc_last = 0.0f64;
+    let mut overshoots = 0usize;
     let max_steps = 200 * s.outputs + 20_000;
     while pos < target - eps {
         if stats.steps > max_steps {
@@ -223,21 +226,37 @@ pub fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Ve
         } else {
             let c0 = cur.q[ic];
             let l0 = cur.reaction;
+            // Do not jump past the target: the run must end exactly on it.
+            let tau_try = if dc_last > 0.0 && pos + dc_last * 1.5 > target {
+                tau * (0.5 * (target - pos) / dc_last).clamp(0.05, 1.0)
+            } else {
+                tau
+            };
             let mut lam = l0;
             trial.copy_from_slice(&cur.q);
             if let Some((dl_prev, tau_prev)) = last {
-                let beta = tau / tau_prev;
+                let beta = tau_try / tau_prev;
                 for i in 0..n {
                     trial[i] += beta * (cur.q[i] - prev_q[i]);
                 }
                 lam += beta * dl_prev;
             }
-            match nw.solve_dissipation(p, law, &cur.states, &mut trial, &mut lam, c0, l0, tau) {
+            match nw.solve_dissipation(p, law, &cur.states, &mut trial, &mut lam, c0, l0, tau_try) {
+                Ok(_) if dir * trial[ic] > target + eps && overshoots < 3 => {
+                    // Would end beyond the target: retry with a smaller increment so the run ends
+                    // on the target under displacement control. If the target lies inside a
+                    // snap-back no forward step can stop there; the run then ends just beyond it.
+                    tau *= 0.25;
+                    last = None;
+                    overshoots += 1;
+                    stats.cuts += 1;
+                }
                 Ok(it) => {
                     commit!(lam);
                     stats.dissipation_steps += 1;
-                    last = Some((lam - l0, tau));
+                    last = Some((lam - l0, tau_try));
                     let dc = (cur.q[ic] - c0).abs();
+                    dc_last = dc * tau_ratio_guard(dir * (cur.q[ic] - c0));
                     pos = dir * cur.q[ic];
                     // Aim at steps of about half the output spacing in the control.
                     if it <= 4 && dc > 0.0 {
@@ -261,6 +280,30 @@ pub fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Ve
                     tau *= 0.5;
                     last = None;
                     if tau < 1e-12 * ledger.external_work.abs().max(1e-300) {
+                        // Last resort: jump over the unstable stretch under displacement control
+                        // (the states recorded are still equilibria; the skipped part is not).
+                        let mut jumped = false;
+                        for k in 1..=4 {
+                            // (may end beyond the target when it lies inside the unstable stretch)
+                            let dh = 0.5 * spacing * k as f64;
+                            trial.copy_from_slice(&cur.q);
+                            trial[ic] = dir * (pos + dh);
+                            if nw.solve_displacement(p, law, &cur.states, &mut trial).is_ok() {
+                                let reaction = nw.f[ic];
+                                commit!(reaction);
+                                pos += dh;
+                                jumped = true;
+                                break;
+                            }
+                        }
+                        if jumped {
+                            dissipating = false;
+                            quick_fallback = true;
+                            h = (0.5 * spacing).max(h_min);
+                            h_prev = 0.0;
+                            tau = tau_hint.max(tau);
+                            continue;
+                        }
                         let msg = format!(
                             "no convergence at control {:.6}: displacement control failed and the dissipation \
                              constraint could not be met with increments down to {tau:.3e} N·mm",
@@ -275,6 +318,15 @@ pub fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Ve
     stats.assemblies = nw.counters.0;
     stats.factorizations = nw.counters.1;
     Ok((rows, stats))
+}
+
+/// A backward dissipation step (snap-back) says nothing about the forward reach of the next one.
+fn tau_ratio_guard(forward: f64) -> f64 {
+    if forward > 0.0 {
+        1.0
+    } else {
+        0.0
+    }
 }
 
 impl From<StepFailure> for CzError {

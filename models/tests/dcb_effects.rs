@@ -1,0 +1,114 @@
+//! Switchable effects of the DCB: null values reproduce the base model exactly, and each effect
+//! does what it says (checked against closed forms where one exists).
+
+mod fe_support;
+use czid_core::{columns, ForwardModel, Record};
+use czid_models::dcb::Dcb;
+use fe_support::*;
+
+fn run(d: &Dcb, law: &TestBilinear) -> Record {
+    d.simulate(law).unwrap_or_else(|f| panic!("{}", f.error))
+}
+
+fn col<'a>(r: &'a Record, c: &str) -> &'a [f64] {
+    r.column(c).unwrap()
+}
+
+fn base() -> Dcb {
+    let mut d = Dcb::paper();
+    d.mesh.interface_element = 0.2;
+    d.control.max_displacement = Some(8.0);
+    d.control.output_points = 40;
+    d
+}
+
+fn law() -> TestBilinear {
+    TestBilinear::new(1e5, 60.0, 0.3)
+}
+
+#[test]
+fn null_effects_written_out_reproduce_the_base_model_bitwise() {
+    let d = base();
+    let mut v = serde_json::to_value(&d).unwrap();
+    v["effects"] = serde_json::json!({
+        "machine_compliance": 0.0, "crack_length_offset": 0.0, "displacement_offset": 0.0,
+        "root_compliance": 0.0, "large_rotation": false
+    });
+    let explicit: Dcb = serde_json::from_value(v).unwrap();
+    assert_eq!(run(&d, &law()), run(&explicit, &law()));
+}
+
+#[test]
+fn crack_length_offset_equals_a_longer_nominal_crack() {
+    let mut a = base();
+    a.effects.crack_length_offset = 1.5;
+    let mut b = base();
+    b.a0 += 1.5;
+    assert_eq!(run(&a, &law()), run(&b, &law()));
+}
+
+#[test]
+fn displacement_offset_shifts_the_curve_and_adds_a_toe() {
+    let mut d = base();
+    d.effects.displacement_offset = 0.3;
+    let (r0, r1) = (run(&base(), &law()), run(&d, &law()));
+    let (x0, x1) = (col(&r0, columns::DISPLACEMENT), col(&r1, columns::DISPLACEMENT));
+    assert_eq!(r1.rows(), r0.rows() + 1);
+    assert_eq!((x1[0], col(&r1, columns::LOAD)[0]), (0.0, 0.0));
+    for (a, b) in x0.iter().zip(&x1[1..]) {
+        assert!((b - a - 0.3).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn machine_compliance_adds_c_m_p_to_the_displacement() {
+    let mut d = base();
+    d.control.max_displacement = Some(2.0);
+    let cm = 0.01;
+    let mut m = d.clone();
+    m.effects.machine_compliance = cm;
+    let (r0, r1) = (run(&d, &law()), run(&m, &law()));
+    // Elastic branch: δ_machine(P) = δ_specimen(P) + C_m P.
+    let c0 = col(&r0, columns::DISPLACEMENT)[1] / col(&r0, columns::LOAD)[1];
+    let c1 = col(&r1, columns::DISPLACEMENT)[1] / col(&r1, columns::LOAD)[1];
+    assert!((c1 - c0 - cm).abs() < 1e-9 * c1, "{c1} vs {c0} + {cm}");
+    // And it tends continuously to the base model.
+    let mut tiny = d.clone();
+    tiny.effects.machine_compliance = 1e-8;
+    let rt = run(&tiny, &law());
+    let (pt, p0) = (col(&rt, columns::LOAD).last().unwrap(), col(&r0, columns::LOAD).last().unwrap());
+    assert!((pt / p0 - 1.0).abs() < 1e-5, "{pt} vs {p0}");
+}
+
+#[test]
+fn root_compliance_is_kanninens_foundation_in_series_with_the_interface() {
+    let mut d = base();
+    d.mesh.interface_element = 0.1;
+    d.control.max_displacement = Some(0.2);
+    d.control.output_points = 2;
+    // Physical value h/(2 E22).
+    let cr = 1.62 / (2.0 * 6_500.0);
+    d.effects.root_compliance = cr;
+    let elastic = TestBilinear::new(1e5, 1e6, 1e6);
+    let r = run(&d, &elastic);
+    let c = col(&r, columns::DISPLACEMENT)[1] / col(&r, columns::LOAD)[1];
+    // Foundation per unit length of one arm: half-model interface 2 b k_n in series with b / c_r.
+    let kf = 1.0 / (1.0 / (2.0 * 20.0 * 1e5) + cr / 20.0);
+    let arm = Arm { e: 130_000.0, g: 2_700.0, b: 20.0, h: 1.62 };
+    let reference = dcb_compliance_foundation(&arm, 50.0, kf);
+    println!("root compliance: C = {c:.6e}, reference {reference:.6e} ({:+.3} %)", 100.0 * (c / reference - 1.0));
+    assert!((c / reference - 1.0).abs() < 0.01);
+}
+
+#[test]
+fn large_rotations_agree_with_small_ones_at_small_openings() {
+    let mut d = base();
+    d.control.max_displacement = Some(1.0);
+    d.control.output_points = 4;
+    let mut l = d.clone();
+    l.effects.large_rotation = true;
+    let (rs, rl) = (run(&d, &law()), run(&l, &law()));
+    let (ps, pl) = (col(&rs, columns::LOAD)[1], col(&rl, columns::LOAD)[1]);
+    println!("P at 0.25 mm: small {ps:.6}, large {pl:.6}");
+    assert!((pl / ps - 1.0).abs() < 1e-3);
+}
