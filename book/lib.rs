@@ -9,6 +9,8 @@ pub mod concepts {}
 pub mod laws {}
 #[doc = include_str!("src/custom_law.md")]
 pub mod custom_law {}
+#[doc = include_str!("src/forward_models.md")]
+pub mod forward_models {}
 #[doc = include_str!("src/optimizers.md")]
 pub mod optimizers {}
 #[doc = include_str!("src/problem_files.md")]

@@ -20,8 +20,7 @@ use czid_problems::plot::{Figure, Series};
 type AnyError = Box<dyn std::error::Error>;
 
 fn write_csv(rec: &Record, path: &Path) -> Result<(), AnyError> {
-    let names: Vec<String> =
-        rec.columns().iter().map(|c| format!("{} [{}]", c.name, c.unit)).collect();
+    let names: Vec<String> = rec.columns().iter().map(|c| format!("{} [{}]", c.name, c.unit)).collect();
     let mut out = names.join(",") + "\n";
     for i in 0..rec.rows() {
         let row: Vec<String> = rec.columns().iter().map(|c| format!("{:.9e}", c.values[i])).collect();
@@ -80,7 +79,8 @@ fn main() -> Result<(), AnyError> {
     // Hartlen DCB-01, small and large rotations, against the test.
     let law = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0)?;
     let (tx, ty) = read_columns(&data.join("DCB-01_Toughness.csv"), "Disp", "Force")?;
-    let mut fig = Figure::new("Hartlen DCB-01 (no fitting)", "opening (mm)", "load (N)").with(Series::points("test", tx, ty));
+    let mut fig =
+        Figure::new("Hartlen DCB-01 (no fitting)", "opening (mm)", "load (N)").with(Series::points("test", tx, ty));
     for large in [false, true] {
         let mut d = Dcb::hartlen_dcb01();
         d.effects.large_rotation = large;

@@ -183,7 +183,6 @@ impl Enf {
             target: self.max_deflection(law) / scale.displacement,
             outputs: self.control.output_points,
             min_step_fraction: 1e-3,
-            max_dissipation_steps: 2000,
             damage_threshold: self.control.damage_threshold,
             crack_origin: self.effective_crack_length(),
             newton: NewtonSettings { max_iterations: self.control.max_iterations, tolerance: self.control.tolerance },

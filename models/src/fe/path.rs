@@ -32,8 +32,6 @@ pub struct PathSettings {
     /// Smallest displacement step, as a fraction of the output spacing, before switching to
     /// dissipation control.
     pub min_step_fraction: f64,
-    /// Largest number of dissipation-controlled steps in one snap-back detour.
-    pub max_dissipation_steps: usize,
     /// Damage at or above which a point counts as fully debonded.
     pub damage_threshold: f64,
     /// Position of the initial crack front (reported as the tip until something debonds).
