@@ -1,5 +1,7 @@
 //! The `czid` command: simulate, identify and compare on problem files; the bundled demo.
 
+mod commands;
+
 use clap::{Args, Parser, Subcommand};
 use czid_core::CzError;
 use czid_problems::compare::{compare, CompareOptions};
@@ -65,6 +67,8 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Benchmark optimizers on standard test functions (optimizers × problems × seeds).
+    Harness(commands::harness::HarnessArgs),
     /// Compare optimizers over several seeds at equal budgets.
     Compare {
         /// Problem file (TOML).
@@ -105,6 +109,7 @@ fn main() -> ExitCode {
             let opts = RunOptions { optimizer, seed, budget, progress: true, resume, stop: Some(ctrl_c_flag()) };
             run_identify(&problem, &out, &opts)
         }
+        Command::Harness(args) => commands::harness::run(&args),
         Command::Synthesize { truth, out, force } => run_synthesize(&truth, &out, force),
         Command::Compare { problem, optimizers, seeds, budget, target, out } => {
             run_compare(&problem, &out, &CompareOptions { optimizers, seeds, budget, target })

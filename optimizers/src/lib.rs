@@ -8,7 +8,7 @@
 //! * [`hybrid::Hybrid`]: a global method, then a local polish.
 //! * [`registry::optimizer_from_config`]: any of these by name and TOML settings.
 //! * [`observers`] (progress bar, history CSV), [`checkpoint`] (atomic state files),
-//!   [`testfns`], [`metrics`] and the benchmark [`harness`].
+//!   [`testfns`], [`metrics`], the benchmark [`harness`], and [`plot`] (PNG/SVG line plots).
 //!
 //! Every method draws its random numbers from one `ChaCha8Rng` on the calling thread and
 //! evaluates populations in parallel with rayon, recording results in index order: the same
@@ -25,6 +25,7 @@ pub mod metrics;
 pub mod miga;
 pub mod nsga2;
 pub mod observers;
+pub mod plot;
 pub mod registry;
 pub mod testfns;
 pub mod transform;

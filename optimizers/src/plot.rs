@@ -1,10 +1,11 @@
 //! Line plots written as PNG or SVG (chosen by the file extension), atomically.
 //!
 //! A small layer over `plotters` with a bundled font (DejaVu Sans, Bitstream Vera licence in
-//! `problems/assets/`), so plots render identically on machines without system fonts.
+//! `optimizers/assets/`), so plots render identically on machines without system fonts. Every
+//! plot of czid (benchmark harness, identification fits, comparisons) is drawn with this font.
 //!
 //! ```no_run
-//! use czid_problems::plot::{Figure, Series};
+//! use czid_optimizers::plot::{Figure, Series};
 //! Figure::new("DCB", "opening (mm)", "load (N)")
 //!     .with(Series::line("model", vec![0.0, 1.0, 2.0], vec![0.0, 10.0, 8.0]))
 //!     .with(Series::points("test", vec![0.5, 1.5], vec![5.0, 9.0]))
@@ -20,7 +21,8 @@ use std::sync::Once;
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
-fn register_font() {
+/// Registers the bundled font as `sans-serif` (once per process).
+pub fn register_font() {
     REGISTER.call_once(|| {
         // The font is bundled and known to be valid; a failure here would leave text unrendered,
         // never corrupt a plot, so it is not worth surfacing.

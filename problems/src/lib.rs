@@ -7,7 +7,7 @@
 //! * [`identify`]: the `identify` and `simulate` workflows, writing results, fits and plots.
 //! * [`identifiability`]: standard errors, correlations and a verdict per identified parameter.
 //! * [`output`]: output folders that are never clobbered by accident, files written atomically.
-//! * [`plot`]: line plots (PNG/SVG) with a bundled font, written atomically.
+//! * [`plot`]: line plots (PNG/SVG) with a bundled font, written atomically (from czid-optimizers).
 //! * [`problem_file`]: the TOML problem file (law, experiments, parameters, objective, optimizer).
 //! * [`synthetic`]: synthetic tests with documented noise, for studies with a known truth.
 
@@ -17,6 +17,6 @@ pub mod identifiability;
 pub mod identification;
 pub mod identify;
 pub mod output;
-pub mod plot;
+pub use czid_optimizers::plot;
 pub mod problem_file;
 pub mod synthetic;

@@ -1,5 +1,5 @@
 //! Convergence curves and data profiles drawn with plotters, as SVG and PNG, with a bundled
-//! font (DejaVu Sans, licence in `optimizers/assets/`) so no system font library is needed.
+//! font (see [`crate::plot`]) so no system font library is needed.
 
 use super::records::{ConvergencePoint, RunRecord};
 use super::report::{quantile, DataProfile};
@@ -10,20 +10,12 @@ use plotters::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 const FAMILY: &str = "sans-serif";
 const SIZE: (u32, u32) = (900, 600);
 /// Floor of `f − f*` on the logarithmic axis.
 const FLOOR: f64 = 1e-12;
 
-fn register_font() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        // The bytes are a valid TrueType font shipped with the crate; a failure would only
-        // leave labels blank.
-        let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
-    });
-}
+use crate::plot::register_font;
 
 fn err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> CzError + '_ {
     move |e| CzError::Io { path: path.display().to_string(), message: format!("plot: {e}") }
