@@ -131,6 +131,7 @@ impl Assembler {
 
     /// Internal forces `f` and tangent `k` at `q`, laws evaluated from the committed `states`.
     /// Returns `false` if a law returned a non-finite value.
+    #[allow(clippy::too_many_arguments)]
     pub fn assemble(
         &mut self,
         p: &FeProblem,

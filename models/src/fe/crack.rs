@@ -107,7 +107,7 @@ pub fn measure(x: &[f64], d: &[f64], threshold: f64, origin: f64, deficit: &mut 
         let left = if start == 0 {
             x[0]
         } else {
-            front_from_inside(x, d, start, (start + 1 <= end).then_some(start + 1), start - 1, 0.0)
+            front_from_inside(x, d, start, (start < end).then_some(start + 1), start - 1, 0.0)
         };
         let right = if end + 1 == n {
             x[n - 1]

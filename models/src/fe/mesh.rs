@@ -83,7 +83,7 @@ impl Mesh {
         if x.len() < 2 {
             return Err(CzError::Simulation("a mesh needs at least two nodes".into()));
         }
-        if x.windows(2).any(|w| !(w[1] > w[0])) {
+        if x.windows(2).any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater)) {
             return Err(CzError::Simulation("mesh nodes must be strictly increasing".into()));
         }
         for (k, l) in layers.iter().enumerate() {

@@ -15,6 +15,10 @@
 //! Forward models ([`crate::dcb`], [`crate::enf`]) build an [`assembly::FeProblem`] from their
 //! configuration and call [`path::run`].
 
+// The kernels index small fixed-size arrays (element and point matrices) by position; index loops
+// state the algebra more plainly than iterator chains there.
+#![allow(clippy::needless_range_loop)]
+
 pub mod assembly;
 pub mod banded;
 pub mod beam;
