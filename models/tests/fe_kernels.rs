@@ -2,6 +2,8 @@
 //! forces are the gradient of its energy and its tangent the Jacobian of its forces; the
 //! large-rotation gap gradients/Hessians likewise; the band LU solves like a dense one.
 
+#![allow(clippy::needless_range_loop)] // index loops mirror the matrix algebra being checked
+
 use czid_models::fe::banded::BandMatrix;
 use czid_models::fe::corotational;
 use czid_models::fe::interface::{kinematics, InterfacePoint, PointKind};
