@@ -3,7 +3,6 @@
 //! * `dcb_paper_table3`: Shi & Zhang's DCB, 0.1 mm interface elements, ST-CZM Table 3, to the
 //!   default final opening (crack 60 % of the way to the end by beam theory).
 //! * `dcb_hartlen_30mm`: Hartlen's DCB-01 to 30 mm opening, bilinear law (G_Ic = 0.8 N/mm).
-//! * `band_lu_*`: one factorisation of the paper DCB's tangent, band LU vs faer's sparse LU.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use czid_core::ForwardModel;

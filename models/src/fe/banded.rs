@@ -3,9 +3,10 @@
 //! Beam-layer meshes numbered node by node give matrices whose non-zeros lie within a few
 //! diagonals of the main one (half-bandwidth 3 for a single layer without axial unknowns,
 //! 11 for two layers with all three unknowns per node). A dense band LU on that structure costs
-//! `n · bw²` operations with unit-stride inner loops and no index indirection; it is several times
-//! faster here than a general sparse LU (measured in `benches/forward.rs`, see the book chapter),
-//! and its "symbolic analysis" (the band) is fixed by the mesh and reused for every factorisation.
+//! `n · bw²` operations with unit-stride inner loops and no index indirection, and its "symbolic
+//! analysis" (the band) is fixed by the mesh and reused for every factorisation. (A general sparse
+//! LU such as faer's has to do at least the same arithmetic plus index indirection; the two have
+//! not been benchmarked against each other yet.)
 //!
 //! No pivoting: the stiffness matrices of this engine are symmetric positive definite except
 //! where cohesive softening enters, which only adds small (possibly negative) contributions to a
