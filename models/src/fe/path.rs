@@ -8,10 +8,14 @@
 //!   abscissae is an equilibrium state, not an interpolation between adaptively placed steps: this
 //!   keeps responses smooth in the parameters (finite-difference Jacobians).
 //! * **Snap-back.** When displacement control cannot proceed even at the smallest step, the
-//!   equilibrium path turns back in the control displacement. The solver then switches to the
-//!   dissipation constraint (released energy per step prescribed, Gutiérrez 2004; Verhoosel, Remmers
-//!   & Gutiérrez 2009), which follows snap-backs because dissipation only increases, until the
-//!   control displacement has passed the point where displacement control failed.
+//!   equilibrium path turns back in the control displacement (a cohesive crack advancing node by
+//!   node does this once per node). The solver then switches to the dissipation constraint
+//!   (released energy per step prescribed, Gutiérrez 2004; Verhoosel, Remmers & Gutiérrez 2009),
+//!   which follows snap-backs because dissipation only increases, with the released energy
+//!   adapted to give control increments of about half an output spacing. It stays there while the
+//!   crack runs and returns to displacement control to end on the target; if the target lies
+//!   inside an unstable stretch, or dissipation control itself stalls, it jumps over the stretch
+//!   under displacement control (the recorded states are still equilibria).
 //! * A run that still fails returns the error and every row that converged.
 
 use czid_core::{CohesiveLaw, CzError, LawState};
