@@ -36,6 +36,8 @@ enum Command {
         problem: PathBuf,
         #[command(flatten)]
         out: OutArgs,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Identify the problem file's parameters.
     Identify {
@@ -43,6 +45,8 @@ enum Command {
         problem: PathBuf,
         #[command(flatten)]
         out: OutArgs,
+        #[command(flatten)]
+        set: SetArgs,
         /// Optimizer instead of the file's (e.g. miga, ga, nsga2, nelder-mead, lbfgs, levenberg-marquardt, hybrid).
         #[arg(long)]
         optimizer: Option<String>,
@@ -87,7 +91,23 @@ enum Command {
         target: f64,
         #[command(flatten)]
         out: OutArgs,
+        #[command(flatten)]
+        set: SetArgs,
     },
+}
+
+#[derive(Args)]
+struct SetArgs {
+    /// Replace a value of the problem file, e.g. `--set law.strength_n=20` or
+    /// `--set models.dcb.effects.large_rotation=true` (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE", value_parser = parse_set)]
+    sets: Vec<(String, String)>,
+}
+
+fn parse_set(s: &str) -> Result<(String, String), String> {
+    s.split_once('=')
+        .map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))
+        .ok_or_else(|| format!("`{s}` should look like PATH=VALUE"))
 }
 
 #[derive(Args)]
@@ -104,15 +124,15 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Demo { out } => demo(&out),
-        Command::Simulate { problem, out } => run_simulate(&problem, &out),
-        Command::Identify { problem, out, optimizer, seed, budget, resume } => {
+        Command::Simulate { problem, out, set } => run_simulate(&problem, &set.sets, &out),
+        Command::Identify { problem, out, set, optimizer, seed, budget, resume } => {
             let opts = RunOptions { optimizer, seed, budget, progress: true, resume, stop: Some(ctrl_c_flag()) };
-            run_identify(&problem, &out, &opts)
+            run_identify(&problem, &set.sets, &out, &opts)
         }
         Command::Harness(args) => commands::harness::run(&args),
         Command::Synthesize { truth, out, force } => run_synthesize(&truth, &out, force),
-        Command::Compare { problem, optimizers, seeds, budget, target, out } => {
-            run_compare(&problem, &out, &CompareOptions { optimizers, seeds, budget, target })
+        Command::Compare { problem, optimizers, seeds, budget, target, out, set } => {
+            run_compare(&problem, &set.sets, &out, &CompareOptions { optimizers, seeds, budget, target })
         }
     };
     match outcome {
@@ -135,16 +155,16 @@ fn ctrl_c_flag() -> Arc<AtomicBool> {
     flag
 }
 
-fn run_simulate(problem: &Path, out: &OutArgs) -> Result<(), CzError> {
-    let problem = LoadedProblem::read(problem)?;
+fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
+    let problem = LoadedProblem::read_with(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, false)?;
     simulate(&problem, &dir)?;
     println!("curves and plots written to {}", dir.path().display());
     Ok(())
 }
 
-fn run_identify(problem: &Path, out: &OutArgs, opts: &RunOptions) -> Result<(), CzError> {
-    let problem = LoadedProblem::read(problem)?;
+fn run_identify(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &RunOptions) -> Result<(), CzError> {
+    let problem = LoadedProblem::read_with(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, opts.resume)?;
     let res = identify(&problem, opts, &dir)?;
     if res.partial {
@@ -174,8 +194,8 @@ fn run_synthesize(truth: &Path, out: &Path, force: bool) -> Result<(), CzError> 
     Ok(())
 }
 
-fn run_compare(problem: &Path, out: &OutArgs, opts: &CompareOptions) -> Result<(), CzError> {
-    let problem = LoadedProblem::read(problem)?;
+fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &CompareOptions) -> Result<(), CzError> {
+    let problem = LoadedProblem::read_with(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, false)?;
     let runs = compare(&problem, opts, &dir)?;
     println!("{:<20} {:>6} {:>12} {:>12} {:>10}", "optimizer", "runs", "median f", "success", "median s");
@@ -209,6 +229,7 @@ fn demo(out: &Path) -> Result<(), CzError> {
     }
     run_identify(
         &problem,
+        &[],
         &OutArgs { out: out.to_path_buf(), force: true },
         &RunOptions { progress: true, stop: Some(ctrl_c_flag()), ..RunOptions::default() },
     )

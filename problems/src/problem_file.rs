@@ -167,6 +167,30 @@ impl LoadedProblem {
         Self::parse(&text, path)
     }
 
+    /// Reads a problem file with some values replaced, e.g. `("law.strength_n", "20")` or
+    /// `("models.dcb.effects.large_rotation", "true")`: paths as in `[[parameter]]` (`law.*`,
+    /// `models.<experiment>.*`), plus `objective.*` and `optimizer.*`. Values are TOML
+    /// (numbers, booleans, quoted strings).
+    pub fn read_with(path: &Path, overrides: &[(String, String)]) -> Result<Self> {
+        let shown = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
+        if overrides.is_empty() {
+            return Self::parse(&text, path);
+        }
+        let mut doc: toml::Table =
+            toml::from_str(&text).map_err(|e| CzError::config(&shown, e.to_string().trim_end()))?;
+        for (key, raw) in overrides {
+            let value: toml::Value =
+                toml::from_str::<toml::Table>(&format!("v = {raw}")).ok().and_then(|mut t| t.remove("v")).ok_or_else(
+                    || CzError::config(format!("--set {key}"), format!("`{raw}` is not a TOML value (quote strings)")),
+                )?;
+            set_path(&mut doc, key, value).map_err(|m| CzError::config(format!("--set {key}"), m))?;
+        }
+        let edited = toml::to_string(&doc).map_err(|e| CzError::config(&shown, e.to_string()))?;
+        Self::parse(&edited, path)
+    }
+
     /// Parses problem-file text; `path` locates relative data files and names errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
         czid_models::registry::ensure_linked();
@@ -238,6 +262,48 @@ impl LoadedProblem {
         }
         Ok(Setup { law, models })
     }
+}
+
+/// Sets `key` (a parameter-style path) in a problem-file document.
+fn set_path(doc: &mut toml::Table, key: &str, value: toml::Value) -> std::result::Result<(), String> {
+    let mut parts: Vec<&str> = key.split('.').collect();
+    let mut node: &mut toml::Table = match parts.first().copied() {
+        Some("law") | Some("objective") | Some("optimizer") => {
+            let head = parts.remove(0);
+            doc.get_mut(head).and_then(|v| v.as_table_mut()).ok_or(format!("the file has no [{head}] table"))?
+        }
+        Some("models") if parts.len() > 2 => {
+            let name = parts[1].to_string();
+            parts.drain(..2);
+            let experiments =
+                doc.get_mut("experiment").and_then(|v| v.as_array_mut()).ok_or("the file has no [[experiment]]")?;
+            let entry = experiments
+                .iter_mut()
+                .filter_map(|e| e.as_table_mut())
+                .find(|e| {
+                    let explicit = e.get("name").and_then(|n| n.as_str()).map(str::to_string);
+                    let stem = e
+                        .get("data")
+                        .and_then(|d| d.get("file"))
+                        .and_then(|f| f.as_str())
+                        .and_then(|f| Path::new(f).file_stem().map(|s| s.to_string_lossy().into_owned()));
+                    explicit.or(stem).as_deref() == Some(name.as_str())
+                })
+                .ok_or(format!("no experiment named `{name}`"))?;
+            entry.get_mut("model").and_then(|v| v.as_table_mut()).ok_or("the experiment has no model table")?
+        }
+        _ => return Err("paths start with law., models.<experiment>., objective. or optimizer.".into()),
+    };
+    let last = parts.pop().ok_or("incomplete path")?;
+    for p in parts {
+        node = node
+            .entry(p.to_string())
+            .or_insert_with(|| toml::Value::Table(Default::default()))
+            .as_table_mut()
+            .ok_or(format!("`{p}` is not a table"))?;
+    }
+    node.insert(last.to_string(), value);
+    Ok(())
 }
 
 fn roundtrip<T: Serialize + serde::de::DeserializeOwned>(v: &T) -> Result<T> {

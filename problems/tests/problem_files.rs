@@ -221,3 +221,26 @@ fn compare_runs_every_optimizer_and_seed_and_writes_summary() {
         assert!(out.file(f).exists(), "{f} missing");
     }
 }
+
+#[test]
+fn overrides_replace_values_by_parameter_path() {
+    let dir = setup_dir("overrides", &problem_text(""));
+    let sets = vec![
+        ("law.stiffness".to_string(), "80".to_string()),
+        ("models.patch.area".to_string(), "2.0".to_string()),
+        ("optimizer.seed".to_string(), "5".to_string()),
+    ];
+    let p = LoadedProblem::read_with(&dir.join("problem.toml"), &sets).unwrap();
+    assert_eq!(p.file.optimizer.seed, 5);
+    let id = p.identification().unwrap();
+    assert_eq!(id.initial().unwrap(), vec![80.0]);
+    for (key, value, expect) in [
+        ("models.nope.area", "1", "no experiment named `nope`"),
+        ("law.stiffness", "abc", "not a TOML value"),
+        ("stiffness", "1", "paths start with"),
+    ] {
+        let e =
+            LoadedProblem::read_with(&dir.join("problem.toml"), &[(key.into(), value.into())]).unwrap_err().to_string();
+        assert!(e.contains(expect), "{key}: {e}");
+    }
+}
