@@ -9,4 +9,5 @@ pub mod effects;
 pub mod enf;
 pub mod fe;
 pub mod laws;
+pub mod materials;
 pub mod registry;
