@@ -8,6 +8,7 @@ pub mod dcb;
 pub mod effects;
 pub mod enf;
 pub mod fe;
+pub mod frp;
 pub mod laws;
 pub mod materials;
 pub mod registry;

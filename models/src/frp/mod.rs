@@ -1,0 +1,20 @@
+//! The FRP-strengthened RC beam and the FRP-to-concrete pull test (Shi & Zhang's second case):
+//!
+//! * [`section`]: fibre-section analysis of a rectangular RC section, optionally plated
+//!   (moment–curvature; cracking, yield and ultimate moments);
+//! * [`bond`]: closed forms for the single-shear pull test (long-bond strength, Chen & Teng's
+//!   effective bond length and bond-length factor, exact short-bond strength for a
+//!   linear-softening law, and the strength for any bond–slip curve);
+//! * [`spec`]: the beam's configuration with our documented choices for what the paper leaves
+//!   out ([`FrpBeamSpec::paper`]).
+//!
+//! The bond–slip law itself is [`crate::laws::LuBondSlip`]; the materials are in
+//! [`crate::materials`].
+
+pub mod bond;
+pub mod section;
+pub mod spec;
+
+pub use bond::{BondStrength, BondedJoint};
+pub use section::{FrpPlate, RcSection, RebarLayer, SectionMoments, SectionPoint, SectionState, UltimateLimit};
+pub use spec::{FrpBeamSpec, Stirrups};
