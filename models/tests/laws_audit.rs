@@ -1,7 +1,9 @@
 //! The verification kit passes every bundled law and catches broken ones.
 
 use czid_core::{CohesiveLaw, Gap, LawEval, LawState, ParameterInfo, Result};
-use czid_models::laws::{verify, Bilinear, Bridging, Exponential, MixedModeCriterion, StCzm, StrengthShape};
+use czid_models::laws::{
+    verify, Bilinear, Bridging, Exponential, LuBondSlip, MixedModeCriterion, StCzm, StrengthShape,
+};
 use serde::{Deserialize, Serialize};
 
 fn bundled() -> Vec<Box<dyn CohesiveLaw>> {
@@ -28,6 +30,7 @@ fn bundled() -> Vec<Box<dyn CohesiveLaw>> {
         ),
         Box::new(Exponential::new(30.0, 0.001, 40.0, 0.002).unwrap()),
         Box::new(Bridging::trilinear(1e5, [30.0, 45.0, 0.25, 0.8], [3.0, 4.5, 0.5, 1.0], 2.0).unwrap()),
+        Box::new(LuBondSlip::from_concrete(47.0, 100.0, 200.0, 1000.0).unwrap()),
     ];
     for (n, t) in shapes {
         laws.push(Box::new(table3.clone().with_shapes(n, t).unwrap()));

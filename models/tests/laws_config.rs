@@ -2,7 +2,7 @@
 //! wrong (unknown law, misspelt key, invalid value).
 
 use czid_core::{law_from_toml, law_to_toml, CohesiveLaw, CzError};
-use czid_models::laws::{Bilinear, Bridging, Exponential, MixedModeCriterion, StCzm, StrengthShape};
+use czid_models::laws::{Bilinear, Bridging, Exponential, LuBondSlip, MixedModeCriterion, StCzm, StrengthShape};
 
 fn all_laws() -> Vec<Box<dyn CohesiveLaw>> {
     let st = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap();
@@ -22,6 +22,7 @@ fn all_laws() -> Vec<Box<dyn CohesiveLaw>> {
         Box::new(power),
         Box::new(Exponential::new(30.0, 0.001, 40.0, 0.002).unwrap()),
         Box::new(Bridging::trilinear(1e5, [30.0, 45.0, 0.25, 0.8], [3.0, 4.5, 0.5, 1.0], 2.0).unwrap()),
+        Box::new(LuBondSlip::from_concrete(47.0, 100.0, 200.0, 1000.0).unwrap()),
     ]
 }
 

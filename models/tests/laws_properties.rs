@@ -10,7 +10,7 @@
 
 use czid_core::{CohesiveLaw, Gap};
 use czid_models::laws::verify::{self, Mode};
-use czid_models::laws::{Bilinear, Bridging, Exponential, MixedModeCriterion, StCzm, StrengthShape};
+use czid_models::laws::{Bilinear, Bridging, Exponential, LuBondSlip, MixedModeCriterion, StCzm, StrengthShape};
 use proptest::prelude::*;
 
 /// Log-uniform in `[lo, hi]`.
@@ -79,6 +79,26 @@ fn exponential() -> impl Strategy<Value = Exponential> {
 
 fn bridging() -> impl Strategy<Value = Bridging> {
     (bilinear(), bilinear()).prop_map(|(matrix, bridging)| Bridging { matrix, bridging })
+}
+
+fn lu_bond_slip() -> impl Strategy<Value = LuBondSlip> {
+    (
+        (log_uniform(0.5, 20.0), log_uniform(1e-3, 0.5), log_uniform(1.5, 1e4), log_uniform(0.7, 20.0)),
+        (log_uniform(0.1, 10.0), log_uniform(0.1, 10.0), log_uniform(1e-9, 0.1)),
+    )
+        .prop_map(|((tau_max, peak_slip, stiffening, energy_ratio), (peel_ratio, peel_energy_ratio, residual))| {
+            LuBondSlip {
+                tau_max,
+                peak_slip,
+                // Initial stiffness as a multiple of τ_max/s0, energy as a multiple of τ_max s0.
+                shear_stiffness: stiffening * tau_max / peak_slip,
+                g_f: energy_ratio * tau_max * peak_slip,
+                peel_strength: peel_ratio * tau_max,
+                peel_energy: peel_energy_ratio * energy_ratio * tau_max * peak_slip,
+                residual,
+            }
+        })
+        .prop_filter("valid", |law| law.validate().is_ok())
 }
 
 /// Vertices in units of the pure-mode separation openings.
@@ -168,6 +188,11 @@ proptest! {
 
     #[test]
     fn bridging_histories_are_admissible(law in bridging(), vertices in history()) {
+        check_history(&law, &vertices)?;
+    }
+
+    #[test]
+    fn lu_bond_slip_histories_are_admissible(law in lu_bond_slip(), vertices in history()) {
         check_history(&law, &vertices)?;
     }
 }
