@@ -15,3 +15,5 @@ pub mod forward_models {}
 pub mod optimizers {}
 #[doc = include_str!("src/problem_files.md")]
 pub mod problem_files {}
+#[doc = include_str!("src/quick_start.md")]
+pub mod quick_start {}

@@ -201,6 +201,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     let (result, wall, forward_seconds) = (run.result, run.wall_seconds, run.forward_seconds);
     bar.finish();
     history.finish()?;
+    relabel_history(&id, out)?;
     let partial = stop.1;
 
     let x = id.space().from_unit(&result.best_x);
@@ -305,6 +306,33 @@ fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &OutputDir, stem:
         }
     }
     Ok(())
+}
+
+/// Rewrites `history.csv` with physical values under `path (unit)` headers instead of the
+/// optimizer's unit-cube coordinates `x0, x1, …`.
+fn relabel_history(id: &Identification, out: &OutputDir) -> Result<()> {
+    let path = out.file("history.csv");
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| CzError::Io { path: path.display().to_string(), message: e.to_string() })?;
+    let params = id.space().parameters();
+    let mut lines = text.lines();
+    let Some(header) = lines.next() else { return Ok(()) };
+    let fixed = header.split(',').count().saturating_sub(params.len());
+    let mut outtext: Vec<String> = header.split(',').take(fixed).map(str::to_string).collect();
+    outtext.extend(params.iter().map(|p| format!("{} ({})", p.path, p.unit)));
+    let mut result = outtext.join(",");
+    result.push('\n');
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        let mut row: Vec<String> = cells.iter().take(fixed).map(|c| c.to_string()).collect();
+        for (p, c) in params.iter().zip(cells.iter().skip(fixed)) {
+            let u: f64 = c.parse().unwrap_or(f64::NAN);
+            row.push(format!("{}", p.from_unit(u)));
+        }
+        result.push_str(&row.join(","));
+        result.push('\n');
+    }
+    out.write("history.csv", &result).map(|_| ())
 }
 
 fn convergence_plot(result: &OptimizationResult, out: &OutputDir) -> Result<()> {

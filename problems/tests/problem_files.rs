@@ -189,6 +189,8 @@ fn identify_recovers_the_known_answer_and_writes_results() {
     assert!((k - 80.0).abs() < 0.8, "identified stiffness {k}, expected 80");
     assert_eq!(res.parameters["law.stiffness"].verdict, "determined");
     assert!(res.evaluations <= 400);
+    let history = std::fs::read_to_string(out.file("history.csv")).unwrap();
+    assert!(history.lines().next().unwrap().ends_with("law.stiffness (MPa/mm)"), "{history}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.file("result.json")).unwrap()).unwrap();
     for key in ["parameters", "objective", "objective_terms", "evaluations", "wall_seconds"] {
