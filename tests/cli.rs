@@ -1,0 +1,86 @@
+//! The `czid` command as a user runs it: bundled problem files load, results land where promised,
+//! and bad input gives a clear message and a non-zero exit code without clobbering anything.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn czid(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_czid")).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("czid-cli-{}-{name}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn every_bundled_problem_file_loads() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for file in [
+        "examples/paper-dcb/problem.toml",
+        "examples/hartlen-dcb/dcb01.toml",
+        "examples/hartlen-dcb/dcb02.toml",
+        "examples/hartlen-dcb/dcb03.toml",
+        "examples/hartlen-dcb/joint.toml",
+    ] {
+        let p = czid_problems::problem_file::LoadedProblem::read(&root.join(file))
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(!p.experiments.is_empty(), "{file}");
+    }
+    czid_problems::synthetic::TruthFile::read(&root.join("examples/paper-dcb/truth.toml")).unwrap();
+}
+
+#[test]
+fn identify_writes_results_and_refuses_to_clobber_them() {
+    let out = scratch("identify");
+    let o = out.to_str().unwrap();
+    let coarse = ["--set", "models.dcb.mesh.interface_element=0.5", "--set", "models.dcb.control.max_displacement=4.0"];
+    let mut args =
+        vec!["identify", "examples/paper-dcb/problem.toml", "--out", o, "--optimizer", "nelder-mead", "--budget", "12"];
+    args.extend(coarse);
+    let first = czid(&args);
+    assert!(first.status.success(), "{}", stderr(&first));
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("result.json")).unwrap()).unwrap();
+    assert_eq!(result["evaluations"].as_u64().unwrap(), 12);
+    assert_eq!(result["parameters"]["law.strength_n"]["unit"], "MPa");
+    // The symmetric DCB never slips: its shear parameters must not be reported as identified.
+    assert_eq!(result["parameters"]["law.strength_t"]["verdict"], "not determined by these data");
+    let before = std::fs::read(out.join("result.json")).unwrap();
+
+    let again = czid(&args);
+    assert!(!again.status.success());
+    assert!(stderr(&again).contains("--force"), "{}", stderr(&again));
+    assert_eq!(std::fs::read(out.join("result.json")).unwrap(), before, "an existing result was modified");
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
+fn bad_input_fails_with_a_message_naming_it() {
+    let out = scratch("bad");
+    let o = out.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["identify", "no/such/problem.toml", "--out", o], "no/such/problem.toml"),
+        (
+            vec!["identify", "examples/paper-dcb/problem.toml", "--out", o, "--optimizer", "simplexx"],
+            "unknown optimizer `simplexx`",
+        ),
+        (vec!["simulate", "examples/paper-dcb/problem.toml", "--out", o, "--set", "models.dcb.h=-1"], "`h`"),
+        (vec!["simulate", "examples/paper-dcb/problem.toml", "--out", o, "--set", "law.u_c_n=0.0001"], "u_c_n"),
+        (
+            vec!["identify", "examples/paper-dcb/problem.toml", "--out", o, "--set", "law.strength_n=100"],
+            "within its bounds",
+        ),
+    ];
+    for (args, expect) in cases {
+        let r = czid(&args);
+        assert!(!r.status.success(), "{args:?} should fail");
+        assert!(stderr(&r).contains(expect), "{args:?}: `{}` should mention `{expect}`", stderr(&r));
+        std::fs::remove_dir_all(&out).ok();
+    }
+}
