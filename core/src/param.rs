@@ -181,10 +181,12 @@ impl ParameterSpace {
         }
         let mut tree = serde_json::to_value(base).map_err(|e| CzError::config("parameters", e.to_string()))?;
         for (p, &v) in self.params.iter().zip(x) {
-            let slot = lookup(&mut tree, &p.path)?;
-            *slot = serde_json::Number::from_f64(v)
+            let number = serde_json::Number::from_f64(v)
                 .map(Value::Number)
                 .ok_or_else(|| CzError::invalid(format!("parameter `{}`", p.path), "value", v, "must be finite"))?;
+            for slot in lookup(&mut tree, &p.path)? {
+                *slot = number.clone();
+            }
         }
         serde_json::from_value(tree).map_err(|e| CzError::config("parameters", e.to_string()))
     }
@@ -195,38 +197,59 @@ impl ParameterSpace {
         self.params
             .iter()
             .map(|p| {
-                lookup(&mut tree, &p.path)?
-                    .as_f64()
-                    .ok_or_else(|| CzError::config(format!("parameter `{}`", p.path), "path does not lead to a number"))
+                let owner = || format!("parameter `{}`", p.path);
+                let values = lookup(&mut tree, &p.path)?
+                    .into_iter()
+                    .map(|v| v.as_f64().ok_or_else(|| CzError::config(owner(), "path does not lead to a number")))
+                    .collect::<Result<Vec<f64>>>()?;
+                // A wildcard ties several values to one parameter: they must start equal.
+                if values.iter().any(|v| *v != values[0]) {
+                    return Err(CzError::config(
+                        owner(),
+                        format!("the values it ties together differ ({values:?}); make them equal in the file"),
+                    ));
+                }
+                Ok(values[0])
             })
             .collect()
     }
 }
 
-/// The value at a dotted path, with an error listing the keys available where the path breaks.
-fn lookup<'a>(tree: &'a mut Value, path: &str) -> Result<&'a mut Value> {
-    let mut node = tree;
+/// The values at a dotted path; a `*` segment matches every key of a table (e.g.
+/// `models.*.material.e11` ties one parameter to every experiment's modulus). Errors list the keys
+/// available where the path breaks.
+fn lookup<'a>(tree: &'a mut Value, path: &str) -> Result<Vec<&'a mut Value>> {
+    let mut nodes = vec![tree];
     let mut walked = String::new();
     for key in path.split('.') {
         let here = if walked.is_empty() { "the configuration".to_string() } else { format!("`{walked}`") };
-        node = match node {
-            Value::Object(map) => {
+        let mut next = Vec::new();
+        for node in nodes {
+            let Value::Object(map) = node else {
+                return Err(CzError::config(format!("parameter `{path}`"), format!("{here} is not a table")));
+            };
+            if key == "*" {
+                next.extend(map.values_mut());
+            } else {
                 let keys: Vec<String> = map.keys().cloned().collect();
-                map.get_mut(key).ok_or_else(|| {
+                next.push(map.get_mut(key).ok_or_else(|| {
                     CzError::config(
                         format!("parameter `{path}`"),
                         format!("{here} has no key `{key}`; it has: {}", keys.join(", ")),
                     )
-                })?
+                })?);
             }
-            _ => return Err(CzError::config(format!("parameter `{path}`"), format!("{here} is not a table"))),
-        };
+        }
+        if next.is_empty() {
+            return Err(CzError::config(format!("parameter `{path}`"), format!("`*` matches nothing in {here}")));
+        }
+        nodes = next;
         if !walked.is_empty() {
             walked.push('.');
         }
         walked.push_str(key);
     }
-    Ok(node)
+    Ok(nodes)
 }
 
 #[cfg(test)]
@@ -244,6 +267,25 @@ mod tests {
         let p = Parameter::new("k", "MPa/mm", 1e3, 1e7).log();
         assert!((p.from_unit(0.5) - 1e5).abs() < 1e-6);
         assert!((p.to_unit(1e5) - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn wildcard_ties_one_parameter_to_several_values() {
+        #[derive(Debug, Serialize, Deserialize, PartialEq)]
+        struct M {
+            e: f64,
+        }
+        #[derive(Debug, Serialize, Deserialize, PartialEq)]
+        struct S {
+            models: std::collections::BTreeMap<String, M>,
+        }
+        let base = S { models: [("a".into(), M { e: 1.0 }), ("b".into(), M { e: 1.0 })].into() };
+        let space = ParameterSpace::new(vec![Parameter::new("models.*.e", "MPa", 0.0, 10.0)]).unwrap();
+        assert_eq!(space.read(&base).unwrap(), vec![1.0]);
+        let s = space.apply(&base, &[3.0]).unwrap();
+        assert!(s.models.values().all(|m| m.e == 3.0));
+        let uneven = S { models: [("a".into(), M { e: 1.0 }), ("b".into(), M { e: 2.0 })].into() };
+        assert!(space.read(&uneven).unwrap_err().to_string().contains("differ"));
     }
 
     #[test]
