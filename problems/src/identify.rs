@@ -184,6 +184,8 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     }
     let x0 = id.initial()?;
 
+    // A resumed run keeps the rows written before the interruption.
+    let earlier = if opts.resume { std::fs::read_to_string(out.file("history.csv")).ok() } else { None };
     let mut history = CsvHistory::create(&out.file("history.csv"))?;
     let mut checkpoint = CheckpointWriter::new(out.file("checkpoint.json"), 1)?;
     let mut bar =
@@ -201,7 +203,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     let (result, wall, forward_seconds) = (run.result, run.wall_seconds, run.forward_seconds);
     bar.finish();
     history.finish()?;
-    relabel_history(&id, out)?;
+    relabel_history(&id, out, earlier.as_deref())?;
     let partial = stop.1;
 
     let x = id.space().from_unit(&result.best_x);
@@ -248,6 +250,10 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     };
     let json = serde_json::to_string_pretty(&res).map_err(|e| CzError::config("result", e.to_string()))?;
     out.write(if partial { "result.partial.json" } else { "result.json" }, &json)?;
+    if !partial {
+        // The interrupted run's partial result is superseded.
+        std::fs::remove_file(out.file("result.partial.json")).ok();
+    }
     write_fits(problem, &outcome, out, "fit")?;
     convergence_plot(&result, out)?;
     Ok(res)
@@ -309,8 +315,9 @@ fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &OutputDir, stem:
 }
 
 /// Rewrites `history.csv` with physical values under `path (unit)` headers instead of the
-/// optimizer's unit-cube coordinates `x0, x1, …`.
-fn relabel_history(id: &Identification, out: &OutputDir) -> Result<()> {
+/// optimizer's unit-cube coordinates `x0, x1, …`, after the rows of an interrupted run (`earlier`,
+/// already relabelled) when this one resumed it.
+fn relabel_history(id: &Identification, out: &OutputDir, earlier: Option<&str>) -> Result<()> {
     let path = out.file("history.csv");
     let text = std::fs::read_to_string(&path)
         .map_err(|e| CzError::Io { path: path.display().to_string(), message: e.to_string() })?;
@@ -322,6 +329,10 @@ fn relabel_history(id: &Identification, out: &OutputDir) -> Result<()> {
     outtext.extend(params.iter().map(|p| format!("{} ({})", p.path, p.unit)));
     let mut result = outtext.join(",");
     result.push('\n');
+    for line in earlier.into_iter().flat_map(|e| e.lines().skip(1)) {
+        result.push_str(line);
+        result.push('\n');
+    }
     for line in lines {
         let cells: Vec<&str> = line.split(',').collect();
         let mut row: Vec<String> = cells.iter().take(fixed).map(|c| c.to_string()).collect();

@@ -246,3 +246,32 @@ fn overrides_replace_values_by_parameter_path() {
         assert!(e.contains(expect), "{key}: {e}");
     }
 }
+
+#[test]
+fn an_interrupted_run_is_marked_partial_and_resumes_to_the_same_result() {
+    use czid_problems::identify::{identify, RunOptions};
+    use czid_problems::output::OutputDir;
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+    let dir = setup_dir("resume", &problem_text("").replace("budget = 100", "budget = 400"));
+    let p = read(&dir).unwrap();
+    let whole =
+        identify(&p, &RunOptions::default(), &OutputDir::create(&dir.join("whole"), false, false).unwrap()).unwrap();
+
+    // Ctrl-C before the first generation ends: the run stops there, marked partial.
+    let out = OutputDir::create(&dir.join("cut"), false, false).unwrap();
+    let stop = RunOptions { stop: Some(Arc::new(AtomicBool::new(true))), ..RunOptions::default() };
+    let cut = identify(&p, &stop, &out).unwrap();
+    assert!(cut.partial && cut.evaluations < whole.evaluations);
+    assert!(out.file("result.partial.json").exists() && !out.file("result.json").exists());
+    let rows_before = std::fs::read_to_string(out.file("history.csv")).unwrap().lines().count();
+
+    let out = OutputDir::create(&dir.join("cut"), false, true).unwrap();
+    let resumed = identify(&p, &RunOptions { resume: true, ..RunOptions::default() }, &out).unwrap();
+    assert!(!resumed.partial);
+    assert!(out.file("result.json").exists() && !out.file("result.partial.json").exists());
+    assert_eq!(resumed.parameters["law.stiffness"].value, whole.parameters["law.stiffness"].value);
+    assert_eq!(resumed.evaluations, whole.evaluations);
+    let rows_after = std::fs::read_to_string(out.file("history.csv")).unwrap().lines().count();
+    assert!(rows_after > rows_before, "the resumed history lost the interrupted run's rows");
+}
