@@ -5,6 +5,8 @@
 //! * [`bond`]: closed forms for the single-shear pull test (long-bond strength, Chen & Teng's
 //!   effective bond length and bond-length factor, exact short-bond strength for a
 //!   linear-softening law, and the strength for any bond–slip curve);
+//! * [`pull`]: the single-shear pull test on the finite-element engine (forward model
+//!   `frp_pull`), any bond–slip law;
 //! * [`spec`]: the beam's configuration with our documented choices for what the paper leaves
 //!   out ([`FrpBeamSpec::paper`]).
 //!
@@ -12,6 +14,7 @@
 //! [`crate::materials`].
 
 pub mod bond;
+pub mod pull;
 pub mod section;
 pub mod spec;
 
