@@ -328,3 +328,238 @@ fn debonding_starts_at_the_loaded_end_and_runs_along_the_plateau() {
     }
     println!("bilinear: process zone on the plateau {:.2} mm (closed form {ell:.2})", z[plateau[0]]);
 }
+
+/// `W(s) = ∫₀ˢ τ` of Lu's curve on a fine grid (trapezoidal), for the first integral of the bond
+/// equation: on a long bond `s'² = 2 W(s) (1 + α)/(E_f t_f)` ahead of the debonded zone.
+struct BondWork {
+    step: f64,
+    w: Vec<f64>,
+}
+
+impl BondWork {
+    fn new(law: &LuBondSlip) -> Self {
+        let n = 200_000;
+        let step = law.separation_slip() / n as f64;
+        let mut w = vec![0.0; n + 1];
+        for i in 1..=n {
+            let (a, b) = ((i - 1) as f64 * step, i as f64 * step);
+            w[i] = w[i - 1] + 0.5 * step * (law.bond_stress(a) + law.bond_stress(b));
+        }
+        BondWork { step, w }
+    }
+    fn at(&self, s: f64) -> f64 {
+        let x = (s / self.step).clamp(0.0, (self.w.len() - 1) as f64);
+        let i = (x.floor() as usize).min(self.w.len() - 2);
+        self.w[i] + (x - i as f64) * (self.w[i + 1] - self.w[i])
+    }
+}
+
+#[test]
+fn profiles_along_the_bond_match_the_record_and_the_bond_equation() {
+    let law = lu();
+    let mut model = pull(600.0, 2.0, false);
+    model.control.max_displacement = Some(0.9);
+    model.control.output_points = 90;
+    let record = model.simulate(&law).unwrap();
+    let slips = [0.1, 0.3, 0.6, 0.9];
+    let profiles = model.profiles(&law, &slips).unwrap();
+    let stiffness = EF * TF / (1.0 + alpha()); // E_f t_f/(1 + α), per unit width
+    let work = BondWork::new(&law);
+    // The softening zone of a long bond, between the peak slip s0 and s_u:
+    // ∫ ds/s' = ∫_{s0}^{s_u} ds / √(2 W(s)/(E_f t_f/(1 + α))) (midpoint rule).
+    let (s0, s_u) = (law.peak_slip, law.separation_slip());
+    let n = 20_000;
+    let softening: f64 = (0..n)
+        .map(|i| {
+            let s = s0 + (s_u - s0) * (i as f64 + 0.5) / n as f64;
+            (s_u - s0) / n as f64 / (2.0 * work.at(s) / stiffness).sqrt()
+        })
+        .sum();
+    let d = col(&record, columns::DISPLACEMENT);
+    for (profile, &slip) in profiles.iter().zip(&slips) {
+        // The same equilibrium as the record's row at that slip.
+        let row = d.iter().position(|&v| (v - slip).abs() < 1e-12).unwrap();
+        let load = col(&record, columns::LOAD)[row];
+        assert!((profile.load / load - 1.0).abs() < 1e-6, "slip {slip}: {} vs {load}", profile.load);
+        let debonded = col(&record, columns::DEBONDED_LENGTH)[row];
+        assert!((profile.debonded_length - debonded).abs() < 1e-6, "slip {slip}");
+        assert!((profile.interface_slip[0] - slip).abs() < 1e-12);
+        // Ahead of the debonded zone the plate strain is the bond equation's:
+        // ε_f = s'/(1 + α) = √(2 W(s)/(E_f t_f/(1 + α)))/(1 + α).
+        let mut worst = 0.0f64;
+        for i in 0..profile.x.len() {
+            let s = profile.interface_slip[i];
+            if profile.x[i] > profile.debonded_length + 4.0 && s > 0.01 * s0 && s < s_u {
+                let exact = (2.0 * work.at(s) / stiffness).sqrt() / (1.0 + alpha());
+                worst = worst.max((profile.plate_strain[i] / exact - 1.0).abs());
+            }
+        }
+        println!(
+            "slip {slip}: load {:.1} N, debonded {:.2} mm, softening {:.2} mm, worst strain error {:.2} %",
+            profile.load,
+            profile.debonded_length,
+            profile.softening_length,
+            100.0 * worst
+        );
+        assert!(worst < 0.02, "slip {slip}: {worst}");
+        if profile.debonded_length > 4.0 {
+            // The debonded plate carries the load: ε_f E_f A_f = P.
+            assert!((profile.plate_strain[0] * EF * BF * TF / profile.load - 1.0).abs() < 1e-6);
+            // Stress-free behind the front, τ_max at the peak slip ahead of it.
+            assert!(profile.bond_stress[0].abs() < 1e-9);
+            let tau = profile.bond_stress.iter().cloned().fold(0.0, f64::max);
+            assert!((tau / law.tau_max - 1.0).abs() < 0.01, "{tau}");
+            // Softening zone length against the first integral, within an element.
+            assert!((profile.softening_length - softening).abs() < 2.0, "{} vs {softening}", profile.softening_length);
+        }
+    }
+    println!("softening zone of a long bond (closed form): {softening:.2} mm");
+    // Past the end of the plateau (1.29 mm here) the path turns back: no state under slip control.
+    let e = model.profiles(&law, &[1.5]).unwrap_err().to_string();
+    assert!(e.contains("snap-back"), "{e}");
+    // Bad requests are named.
+    let e = model.profiles(&law, &[0.3, 0.1]).unwrap_err().to_string();
+    assert!(e.contains("profile slips"), "{e}");
+    let e = model.profiles(&law, &[f64::NAN]).unwrap_err().to_string();
+    assert!(e.contains("profile slips"), "{e}");
+}
+
+#[test]
+fn elastic_concrete_equals_a_two_layer_model_with_a_concrete_layer() {
+    // The model carries the concrete's axial compliance in an equivalent plate stiffness. Here
+    // the test builds the literal two-layer model on the engine: a plate bar and an elastic
+    // concrete bar (E_c, b_c × h_c) held at the loaded end, joined by the law.
+    let law = lu();
+    let (length, h) = (400.0, 4.0);
+    let n = (length / h) as usize;
+    let x = fe::mesh::uniform(0.0, length, n);
+    let bar = |section: Section, y: f64| Layer { section, y, axial: true, first: 0, last: n, surface: None };
+    let concrete = bar(Section { e: ec(), g: ec(), b: BC, h: HC }, 0.5 * HC);
+    let plate = bar(Section { e: EF, g: EF, b: BF, h: TF }, HC + 0.5 * TF);
+    let mesh = Mesh::new(x, vec![concrete, plate], 0).unwrap();
+    let points = (0..=n)
+        .map(|i| {
+            let trib = if i == 0 || i == n { 0.5 * h } else { h };
+            InterfacePoint {
+                node: i,
+                upper: 1,
+                lower: Some(0),
+                area: BF * trib,
+                factor: 1.0,
+                kind: PointKind::Cohesive,
+            }
+        })
+        .collect();
+    let mut fixed = vec![mesh.dofs(0, 0)[0]];
+    for i in 0..=n {
+        fixed.extend([mesh.dofs(0, i)[1], mesh.dofs(0, i)[2], mesh.dofs(1, i)[1], mesh.dofs(1, i)[2]]);
+    }
+    let control = mesh.dofs(1, 0)[0];
+    let problem =
+        FeProblem { mesh, points, springs: vec![], fixed, control, large_rotation: false, contact_stiffness: 0.0 };
+    let target = 0.7; // on the plateau: the loaded end separates at 0.485 mm
+    let path = PathSettings {
+        target: -target,
+        outputs: 35,
+        min_step_fraction: 1e-3,
+        damage_threshold: 1.0 - 1e-9,
+        crack_origin: 0.0,
+        newton: NewtonSettings::default(),
+    };
+    let (rows, _) = fe::run(&problem, &law, &path).unwrap();
+    let mut model = pull(length, h, false);
+    model.control.max_displacement = Some(target);
+    model.control.output_points = 35;
+    let record = model.simulate(&law).unwrap();
+    let (d, p, a) =
+        (col(&record, columns::DISPLACEMENT), col(&record, columns::LOAD), col(&record, columns::DEBONDED_LENGTH));
+    let mut compared = 0;
+    for k in 1..=35 {
+        let slip = target * k as f64 / 35.0;
+        let two_layer = rows.iter().find(|r| (r.control + slip).abs() < 1e-12).unwrap();
+        let i = d.iter().position(|&v| (v - slip).abs() < 1e-12).unwrap();
+        assert!((p[i] / -two_layer.reaction - 1.0).abs() < 1e-6, "slip {slip}: {} vs {}", p[i], -two_layer.reaction);
+        assert!((a[i] - two_layer.crack.debonded).abs() < 1e-6, "slip {slip}");
+        let w = col(&record, columns::EXTERNAL_WORK)[i];
+        assert!((w / two_layer.external_work - 1.0).abs() < 1e-6, "slip {slip}");
+        compared += 1;
+    }
+    assert_eq!(compared, 35);
+}
+
+#[test]
+fn shear_envelope_finds_the_laws_peak_and_separation() {
+    use czid_models::frp::pull::shear_envelope;
+    let law = lu();
+    let env = shear_envelope(&law, 1.0 - 1e-9).unwrap();
+    // Lu's law: τ_max at s0, separation at s_u, damage 1 − s_e/s0 at the peak (the law's own
+    // closed forms).
+    assert!((env.peak_slip / law.peak_slip - 1.0).abs() < 1e-6, "{}", env.peak_slip);
+    assert!((env.peak_stress / law.tau_max - 1.0).abs() < 1e-9);
+    assert!((env.separation_slip / law.separation_slip() - 1.0).abs() < 1e-4, "{}", env.separation_slip);
+    assert!((env.peak_damage - (1.0 - law.elastic_slip() / law.peak_slip)).abs() < 1e-6);
+    // Bilinear: peak τ at δ0 = τ/K, separation at δf = 2 G/τ, no damage at the peak.
+    let bl = bilinear();
+    let env = shear_envelope(&bl, 1.0 - 1e-9).unwrap();
+    assert!((env.peak_slip / (bl.strength_t / bl.penalty) - 1.0).abs() < 1e-6);
+    assert!((env.separation_slip / (2.0 * bl.g_iic / bl.strength_t) - 1.0).abs() < 1e-6);
+    assert!(env.peak_damage < 1e-6);
+}
+
+#[test]
+fn configuration_files_and_named_errors() {
+    use czid_core::ForwardModel;
+    czid_models::registry::ensure_linked();
+    assert!(czid_models::registry::MODEL_TYPES.contains(&"frp_pull"));
+    let text = r#"
+        type = "frp_pull"
+        bond_length = 300.0
+        [plate]
+        width = 100.0
+        thickness = 0.999
+        modulus = 200000.0
+        [concrete]
+        width = 200.0
+        depth = 200.0
+        fc_cylinder = 47.0
+        [mesh]
+        interface_element = 5.0
+        [control]
+        max_displacement = 0.3
+        output_points = 10
+    "#;
+    let model: Box<dyn ForwardModel> = toml::from_str(text).unwrap();
+    assert_eq!(model.name(), "frp_pull");
+    model.validate().unwrap();
+    let record = model.simulate(&lu()).unwrap();
+    assert!(peak(&record) > 0.0);
+    // Round trip of the concrete type.
+    let direct: FrpPull = toml::from_str(&text.replace("type = \"frp_pull\"", "")).unwrap();
+    let back: FrpPull = toml::from_str(&toml::to_string(&direct).unwrap()).unwrap();
+    assert_eq!(back, direct);
+    // Unknown fields are refused.
+    let typo = text.replace("depth = 200.0", "dept = 200.0");
+    assert!(toml::from_str::<Box<dyn ForwardModel>>(&typo).is_err());
+    // Invalid values are named.
+    let cases: [(&str, &str, &str); 6] = [
+        ("bond_length = 300.0", "bond_length = -1.0", "`bond_length`"),
+        ("width = 100.0", "width = 300.0", "`plate.width`"),
+        ("depth = 200.0", "depth = 0.0", "`concrete.depth`"),
+        ("modulus = 200000.0", "modulus = -5.0", "`plate.modulus`"),
+        ("interface_element = 5.0", "interface_element = 0.0", "`mesh.interface_element`"),
+        ("output_points = 10", "output_points = 0", "`control.output_points`"),
+    ];
+    for (from, to, field) in cases {
+        let bad: Box<dyn ForwardModel> = toml::from_str(&text.replace(from, to)).unwrap();
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(e.contains(field), "{to}: {e}");
+        let failure = bad.simulate(&lu()).unwrap_err();
+        assert!(failure.error.to_string().contains(field));
+    }
+    let mut m = pull(300.0, 1e-4, false);
+    let e = m.validate().unwrap_err().to_string();
+    assert!(e.contains("`mesh.interface_element`"), "{e}");
+    m.mesh.interface_element = 2.0;
+    m.concrete.modulus = Some(f64::NAN);
+    assert!(m.validate().unwrap_err().to_string().contains("`concrete.modulus`"));
+}

@@ -57,9 +57,22 @@
 //! gives the slip and the load as positive numbers). A long bond reaches `P_max` and keeps it while
 //! the debonded zone runs along the bond (the slip grows by the stretch of the debonded plate);
 //! when what is left is too short to carry `P_max`, the load drops and the loaded-end slip
-//! *decreases* (snap-back: the debonded plate recovers its stretch). The engine follows that under
-//! its dissipation constraint ([`crate::fe::path`]); the record then holds rows with decreasing
-//! displacement, and the final state (everything debonded, no load) is held up to the target slip.
+//! *decreases* (snap-back: the debonded plate recovers its stretch) down to about the law's
+//! separation slip at zero load. Short bonds (below about `L_e`) soften after their peak instead.
+//!
+//! * By default a run ends on the plateau, when the debonded zone has come within `2 L_e` of the
+//!   free end, or at the law's separation slip for bonds shorter than `2 L_e`
+//!   ([`FrpPull::default_slip`]): the range a test under slip control records before the joint
+//!   fails.
+//! * A larger `control.max_displacement` (up to [`FrpPull::full_range_slip`] and beyond) follows
+//!   the final snap-back under the engine's dissipation constraint ([`crate::fe::path`]); the
+//!   record then holds rows of decreasing slip, and the separated state (no load) is held up to
+//!   the target. This works for laws with a finite softening branch (bilinear: checked to the
+//!   final dissipation `b_f L G_f`). With Lu's law the remaining bond sits in the law's long
+//!   exponential tail, nearly stress-free, and the engine's displacement control can converge
+//!   straight onto the separated state (an equilibrium at any slip beyond `s_u`), skipping the
+//!   snap-back; the rows after such a jump are equilibria, but the dissipated energy credited
+//!   across it is not the law's (its final value exceeds `b_f L G_f`).
 //!
 //! # What is recorded
 //!
@@ -568,11 +581,13 @@ impl FrpPull {
     /// The state along the bond at each loaded-end slip of `slips` (increasing, mm).
     ///
     /// The engine's path follower reports global quantities only, so this follows the loading
-    /// path itself under displacement control (adaptive steps on the engine's Newton solver) and
-    /// reads the plate strain and the interface state at the requested slips. It reaches every
-    /// state of the rising branch and of the debonding plateau of a long bond (where every point
-    /// loads monotonically, so the state does not depend on the step sequence); a slip beyond the
-    /// final snap-back, where displacement control cannot follow the path, is an error naming it.
+    /// path itself under displacement control (adaptive steps on the engine's Newton solver,
+    /// without the path follower's extrapolating predictor) and reads the plate strain and the
+    /// interface state at the requested slips. It reaches every state of the rising branch, of the
+    /// softening branch of a short bond and of the debonding plateau of a long one (every point
+    /// loads monotonically there, so the state does not depend on the step sequence and equals the
+    /// record's at the same slip). A slip past the end of the plateau, where the path turns back
+    /// and slip control has no neighbouring state, is an error.
     pub fn profiles(&self, law: &dyn CohesiveLaw, slips: &[f64]) -> Result<Vec<BondProfile>> {
         law.validate()?;
         let p = self.problem()?;
