@@ -27,12 +27,15 @@ fn every_bundled_problem_file_loads() {
         "examples/hartlen-dcb/dcb02.toml",
         "examples/hartlen-dcb/dcb03.toml",
         "examples/hartlen-dcb/joint.toml",
+        "examples/frp-pull/problem.toml",
     ] {
         let p = czid_problems::problem_file::LoadedProblem::read(&root.join(file))
             .unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(!p.experiments.is_empty(), "{file}");
     }
-    czid_problems::synthetic::TruthFile::read(&root.join("examples/paper-dcb/truth.toml")).unwrap();
+    for truth in ["examples/paper-dcb/truth.toml", "examples/frp-pull/truth.toml"] {
+        czid_problems::synthetic::TruthFile::read(&root.join(truth)).unwrap_or_else(|e| panic!("{truth}: {e}"));
+    }
 }
 
 #[test]
