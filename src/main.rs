@@ -224,7 +224,7 @@ fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &
 /// a minute on a laptop.
 const DEMO_OPTIMIZER: &[(&str, &str)] = &[
     ("optimizer.type", "\"hybrid\""),
-    ("optimizer.budget", "1500"),
+    ("optimizer.budget", "600"),
     ("optimizer.settings", "{ global = { type = \"miga\" }, local = { type = \"levenberg-marquardt\", fd_step = 1e-3 }, local_fraction = 0.2 }"),
 ];
 
