@@ -158,9 +158,17 @@ fn ctrl_c_flag() -> Arc<AtomicBool> {
 fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
     let problem = LoadedProblem::read_with(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, false)?;
-    simulate(&problem, &dir)?;
+    let outcome = simulate(&problem, &dir)?;
     println!("curves and plots written to {}", dir.path().display());
-    Ok(())
+    if outcome.failures.is_empty() {
+        Ok(())
+    } else {
+        // The curves computed so far are written; the run itself did not finish.
+        Err(CzError::Simulation(format!(
+            "stopped early (curves hold the converged steps): {}",
+            outcome.failures.join("; ")
+        )))
+    }
 }
 
 fn run_identify(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &RunOptions) -> Result<(), CzError> {
