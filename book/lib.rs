@@ -19,3 +19,5 @@ pub mod optimizers {}
 pub mod problem_files {}
 #[doc = include_str!("src/quick_start.md")]
 pub mod quick_start {}
+#[doc = include_str!("src/paper_dcb.md")]
+pub mod paper_dcb {}
