@@ -21,3 +21,5 @@ pub mod problem_files {}
 pub mod quick_start {}
 #[doc = include_str!("src/paper_dcb.md")]
 pub mod paper_dcb {}
+#[doc = include_str!("src/real_dcb.md")]
+pub mod real_dcb {}
