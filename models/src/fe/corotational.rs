@@ -3,8 +3,7 @@
 //! Crisfield's formulation (Non-linear Finite Element Analysis of Solids and Structures, vol. 1,
 //! ch. 7): the element's rigid-body motion is taken out by following its chord; what is left, the
 //! chord stretch `ū = l_n − l_0` and the nodal rotations relative to the chord `θ̄_i = θ_i − (β − β_0)`,
-//! is small and is resisted by the same linear Timoshenko stiffness as in [`super::beam`]
-//! ([`super::beam::local_stiffness`]). The
+//! is small and is resisted by the same linear Timoshenko stiffness as in [`super::beam`]. The
 //! tangent adds the geometric terms `z zᵀ N / l_n + (r zᵀ + z rᵀ)(M_1 + M_2)/l_n²`.
 
 use super::mesh::Section;
@@ -31,8 +30,11 @@ pub fn element(s: &Section, x1: f64, x2: f64, q: &[f64; 6]) -> CrElement {
     let ub = ln - l0;
     let t1 = q[2] - beta;
     let t2 = q[5] - beta;
-    // Local stiffness on [ū, θ̄1, θ̄2]: the small-rotation element's (exact Timoshenko).
-    let kl = super::beam::local_stiffness(s, l0);
+    // Local stiffness on [ū, θ̄1, θ̄2]: stretch, bending, and midpoint shear γ = −(θ̄1 + θ̄2)/2.
+    let (ea, ei, ga) = (s.ea(), s.ei(), s.ga());
+    let kb = ei / l0;
+    let ks = 0.25 * ga * l0;
+    let kl = [[ea / l0, 0.0, 0.0], [0.0, kb + ks, -kb + ks], [0.0, -kb + ks, kb + ks]];
     let dl = [ub, t1, t2];
     let mut fl = [0.0; 3];
     for i in 0..3 {
