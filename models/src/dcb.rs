@@ -89,6 +89,10 @@ pub struct Dcb {
 
 const OWNER: &str = "model dcb";
 
+/// The engine's choices for DCB runs: segment integration of the interface (smooth crack growth,
+/// see [`crate::fe::segment`]) and records on the output grid.
+const RUN: fe::RunOptions = fe::RunOptions { interface: fe::InterfaceRule::Segments, outputs_only: true, window: true };
+
 impl Dcb {
     /// The DCB of Shi & Zhang (l = 180, b = 20, a0 = 50, 2h = 3.24 mm; E11 = 130, E22 = 6.5,
     /// G13 = 2.7 GPa), plane stress, 0.1 mm interface elements.
@@ -118,7 +122,7 @@ impl Dcb {
             h_lower: None,
             material: Material { e11: 19_300.0, e22: 6_110.0, g13: 2_288.0, nu13: 0.0, plane: Default::default() },
             symmetry: Symmetry::Half,
-            mesh: MeshSettings { interface_element: 0.2, arm_element: 1.0 },
+            mesh: MeshSettings { interface_element: 0.2, arm_element: 1.0, ..Default::default() },
             control: ControlSettings { max_displacement: Some(30.0), ..Default::default() },
             effects: Effects::default(),
         }
@@ -182,7 +186,7 @@ impl Dcb {
         self.validate()?;
         let fx = &self.effects;
         let a = self.effective_crack_length();
-        let x = graded(&[0.0, a, self.length], &[self.mesh.arm_element, self.mesh.interface_element]);
+        let x = graded(&[0.0, a, self.length], &[self.mesh.arm_element, self.mesh.crack_element()]);
         let nn = x.len();
         let tip = x.iter().position(|&v| (v - a).abs() <= 1e-9 * self.length).unwrap_or(0);
         let large = fx.large_rotation;
@@ -298,7 +302,7 @@ impl ForwardModel for Dcb {
         law.validate().map_err(fail)?;
         let (p, scale) = self.problem().map_err(fail)?;
         let path = self.path(law, &scale);
-        match fe::run(&p, law, &path) {
+        match fe::run_with(&p, law, &path, &RUN) {
             Ok((rows, _)) => Ok(beamtest::to_record(&rows, &scale)),
             Err(f) => Err(SimulationFailure { error: f.error, partial: beamtest::to_record(&f.rows, &scale) }),
         }
@@ -310,6 +314,6 @@ pub fn simulate_with_stats(dcb: &Dcb, law: &dyn CohesiveLaw) -> Result<(Record, 
     law.validate()?;
     let (p, scale) = dcb.problem()?;
     let path = dcb.path(law, &scale);
-    let (rows, stats) = fe::run(&p, law, &path).map_err(|f| f.error)?;
+    let (rows, stats) = fe::run_with(&p, law, &path, &RUN).map_err(|f| f.error)?;
     Ok((beamtest::to_record(&rows, &scale), stats))
 }

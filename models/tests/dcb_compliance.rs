@@ -47,7 +47,10 @@ fn full_model_equals_half_model_for_equal_arms() {
     let mut full = dcb.clone();
     full.symmetry = Symmetry::Full;
     let (ch, cf) = (compliance(&dcb, &law), compliance(&full, &law));
-    assert!((ch / cf - 1.0).abs() < 1e-7, "{ch} vs {cf}");
+    // Equal to round-off: the full model carries axial unknowns, whose stiffness EA/l at the
+    // 0.025 mm beam elements of the bonded region makes its system far worse conditioned (the
+    // difference is 1e-8 at 0.1 mm elements).
+    assert!((ch / cf - 1.0).abs() < 1e-6, "{ch} vs {cf}");
 }
 
 #[test]

@@ -5,14 +5,20 @@
 //! points (one 2×2 law tangent each, at the nodes). With large rotations the co-rotational beams are
 //! re-assembled each iteration. No allocation happens per iteration: every buffer lives in the
 //! [`Assembler`].
+//!
+//! The interface is integrated by the nodal rule ([`InterfaceRule::Nodal`]: each point with its
+//! tributary area) or, between neighbouring cohesive points, by [`super::segment`]'s exact
+//! integration over a traction field with its kinks at the damage fronts
+//! ([`InterfaceRule::Segments`]).
 
 use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent};
 
 use super::banded::BandMatrix;
 use super::beam;
 use super::corotational;
-use super::interface::{self, InterfacePoint, PointKind};
+use super::interface::{self, GapKinematics, InterfacePoint, PointKind};
 use super::mesh::{Mesh, NONE};
+use super::segment::{self, End, ModeOne, Segment};
 
 /// A linear spring of stiffness `k` (N/mm) between unknowns `i` and `j` (`j` = [`NONE`]: ground).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,6 +61,24 @@ struct Element {
     x2: f64,
 }
 
+/// How the cohesive interface is integrated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum InterfaceRule {
+    /// Each point carries its tributary area (trapezoidal rule).
+    #[default]
+    Nodal,
+    /// Neighbouring cohesive points form segments integrated exactly over a piecewise linear
+    /// traction field with kinks at the onset and failure fronts ([`super::segment`]).
+    Segments,
+}
+
+/// Per-point data of the last assembly kept for the segment rule.
+#[derive(Clone, Copy, Debug, Default)]
+struct PointData {
+    kin: GapKinematics,
+    d: Tangent,
+}
+
 /// Assembly workspace for one [`FeProblem`].
 pub struct Assembler {
     elements: Vec<Element>,
@@ -64,6 +88,17 @@ pub struct Assembler {
     pub trial: Vec<LawEval>,
     /// Gaps of the last assembly.
     pub gaps: Vec<Gap>,
+    /// Segments of the interface (empty with the nodal rule).
+    pub segments: Vec<Segment>,
+    /// Fronts found in each segment by the last assembly (fractions from the segment's left end:
+    /// onset, failure).
+    pub fronts: Vec<[Option<f64>; 2]>,
+    /// Recoverable energy `∫ ½ T·g` of each segment at the last assembly (N·mm).
+    pub segment_stored: Vec<f64>,
+    covered: Vec<bool>,
+    mode_one: Option<ModeOne>,
+    data: Vec<PointData>,
+    hessians: Vec<interface::Hessian>,
     n: usize,
     strength: [f64; 2],
     hess: Box<interface::Hessian>,
@@ -82,8 +117,13 @@ fn get(q: &[f64], d: usize) -> f64 {
 }
 
 impl Assembler {
-    /// Prepares element lists and the constant part of the tangent.
+    /// Prepares element lists and the constant part of the tangent (nodal interface rule).
     pub fn new(p: &FeProblem, law: &dyn CohesiveLaw) -> Self {
+        Self::with_rule(p, law, InterfaceRule::Nodal)
+    }
+
+    /// [`Assembler::new`] with the interface integrated by `rule`.
+    pub fn with_rule(p: &FeProblem, law: &dyn CohesiveLaw, rule: InterfaceRule) -> Self {
         let mesh = &p.mesh;
         let mut elements = Vec::new();
         for (k, layer) in mesh.layers.iter().enumerate() {
@@ -116,13 +156,25 @@ impl Assembler {
         }
         let np = p.points.len();
         let zero = LawEval { traction: Default::default(), tangent: Default::default(), state: LawState::default() };
-        let st = law.strength();
-        let strength = [st[0].abs().max(1e-300), st[1].abs().max(1e-300)];
+        let strength = strengths(law);
+        let (segments, covered) = match rule {
+            InterfaceRule::Nodal => (Vec::new(), vec![false; np]),
+            InterfaceRule::Segments => segment::segments(mesh, &p.points),
+        };
+        let mode_one = if segments.is_empty() { None } else { ModeOne::of(law) };
+        let large = p.large_rotation && !segments.is_empty();
         Assembler {
             elements,
             linear,
             trial: vec![zero; np],
             gaps: vec![Gap::zeros(); np],
+            fronts: vec![[None; 2]; segments.len()],
+            segment_stored: vec![0.0; segments.len()],
+            segments,
+            covered,
+            mode_one,
+            data: vec![PointData::default(); np],
+            hessians: if large { vec![[[[0.0; 8]; 8]; 2]; np] } else { Vec::new() },
             n,
             strength,
             hess: Box::new([[[0.0; 8]; 8]; 2]),
@@ -169,6 +221,10 @@ impl Assembler {
                     let ev = law.evaluate(&gap, &states[ip]);
                     let d = if secant {
                         secant_tangent(&gap, &ev)
+                    } else if self.covered[ip] {
+                        // Segments: forces are continuous at the elastic limit, so the law's own
+                        // tangent is the consistent Jacobian (see `fe::window`).
+                        ev.tangent
                     } else {
                         self.loading_tangent(law, &gap, &states[ip], &ev)
                     };
@@ -185,6 +241,14 @@ impl Assembler {
             }
             self.trial[ip] = ev;
             self.gaps[ip] = gap;
+            if self.covered[ip] {
+                // Integrated through its segments below.
+                self.data[ip] = PointData { kin, d };
+                if kin.nonlinear {
+                    self.hessians[ip] = *self.hess;
+                }
+                continue;
+            }
             let w = pt.area * pt.factor;
             // f += w Gᵀ T ; K += w (Gᵀ D G + T_n H_n + T_t H_t)
             let g = &kin.grad;
@@ -212,6 +276,55 @@ impl Assembler {
                 }
             }
         }
+        for (is, sg) in self.segments.iter().enumerate() {
+            let end = |i: usize| End {
+                gap: self.gaps[i],
+                t: self.trial[i].traction,
+                d: self.data[i].d,
+                damage: self.trial[i].state.damage,
+                state: &states[i],
+            };
+            let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), law, self.mode_one.as_ref());
+            self.fronts[is] = sf.fronts;
+            self.segment_stored[is] = sf.stored;
+            let pts = [sg.a, sg.b];
+            for (i, &pi) in pts.iter().enumerate() {
+                let ki = &self.data[pi].kin;
+                let fi = sf.f[i];
+                for r in 0..8 {
+                    let dr = ki.dofs[r];
+                    if dr == NONE {
+                        continue;
+                    }
+                    let (g0, g1) = (ki.grad[0][r], ki.grad[1][r]);
+                    if g0 == 0.0 && g1 == 0.0 && !ki.nonlinear {
+                        continue;
+                    }
+                    f[dr] += g0 * fi[0] + g1 * fi[1];
+                    // Row r of G_iᵀ J_ij, times G_j.
+                    for (j, &pj) in pts.iter().enumerate() {
+                        let kj = &self.data[pj].kin;
+                        let jac = &sf.jac[i][j];
+                        let ra0 = g0 * jac[(0, 0)] + g1 * jac[(1, 0)];
+                        let ra1 = g0 * jac[(0, 1)] + g1 * jac[(1, 1)];
+                        for c in 0..8 {
+                            let dc = kj.dofs[c];
+                            if dc == NONE {
+                                continue;
+                            }
+                            let mut v = ra0 * kj.grad[0][c] + ra1 * kj.grad[1][c];
+                            if i == j && ki.nonlinear {
+                                let h = &self.hessians[pi];
+                                v += fi[0] * h[0][r][c] + fi[1] * h[1][r][c];
+                            }
+                            if v != 0.0 {
+                                k.add(dr, dc, v);
+                            }
+                        }
+                    }
+                }
+            }
+        }
         ok
     }
 
@@ -227,21 +340,7 @@ impl Assembler {
     /// by that margin. Only the iteration matrix changes; tractions, hence converged solutions,
     /// are the law's own.
     fn loading_tangent(&self, law: &dyn CohesiveLaw, gap: &Gap, state: &LawState, ev: &LawEval) -> Tangent {
-        if ev.state.damage > state.damage || ev.state.damage >= 1.0 {
-            return ev.tangent; // already loading, or nothing left to damage
-        }
-        // Far from the surface (low traction, no damage) the secant is the tangent.
-        let s = &self.strength;
-        let ratio = (ev.traction[0].max(0.0) / s[0]).powi(2) + (ev.traction[1] / s[1]).powi(2);
-        if state.damage <= 0.0 && ratio < 0.8 {
-            return ev.tangent;
-        }
-        let probe = law.evaluate(&(gap * (1.0 + LOADING_BIAS)), state);
-        if probe.state.damage > state.damage && probe.tangent.iter().all(|v| v.is_finite()) {
-            probe.tangent
-        } else {
-            ev.tangent
-        }
+        loading_tangent(law, &self.strength, gap, state, ev)
     }
 
     /// Strain energy of the beams and springs (N·mm) at `q`.
@@ -266,10 +365,55 @@ impl Assembler {
         e
     }
 
+    /// Recoverable energy of the interface integrated as the forces are: the segments' `∫ ½ T·g`
+    /// and the nodal rule for the points outside segments (N·mm). `stored` holds each point's
+    /// own recoverable energy per unit area.
+    pub fn interface_stored(&self, p: &FeProblem, stored: &[f64]) -> f64 {
+        let mut e: f64 = self.segment_stored.iter().sum();
+        for (i, pt) in p.points.iter().enumerate() {
+            if !self.covered[i] {
+                e += pt.area * pt.factor * stored[i];
+            }
+        }
+        e
+    }
+
     /// Number of unknowns.
     pub fn n(&self) -> usize {
         self.n
     }
+}
+
+/// The iteration tangent of a cohesive point (see [`Assembler`]'s `loading_tangent`), for a law
+/// whose pure-mode strengths are `strength` (absolute values, positive).
+pub(crate) fn loading_tangent(
+    law: &dyn CohesiveLaw,
+    strength: &[f64; 2],
+    gap: &Gap,
+    state: &LawState,
+    ev: &LawEval,
+) -> Tangent {
+    if ev.state.damage > state.damage || ev.state.damage >= 1.0 {
+        return ev.tangent; // already loading, or nothing left to damage
+    }
+    // Far from the surface (low traction, no damage) the secant is the tangent.
+    let s = strength;
+    let ratio = (ev.traction[0].max(0.0) / s[0]).powi(2) + (ev.traction[1] / s[1]).powi(2);
+    if state.damage <= 0.0 && ratio < 0.8 {
+        return ev.tangent;
+    }
+    let probe = law.evaluate(&(gap * (1.0 + LOADING_BIAS)), state);
+    if probe.state.damage > state.damage && probe.tangent.iter().all(|v| v.is_finite()) {
+        probe.tangent
+    } else {
+        ev.tangent
+    }
+}
+
+/// Pure-mode strengths of `law` as positive numbers (a zero strength is replaced by a tiny one).
+pub(crate) fn strengths(law: &dyn CohesiveLaw) -> [f64; 2] {
+    let st = law.strength();
+    [st[0].abs().max(1e-300), st[1].abs().max(1e-300)]
 }
 
 /// Secant stiffness `diag(T_n/g_n, T_t/g_t)` of a damage law (whose tractions are proportional to

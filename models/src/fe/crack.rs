@@ -120,3 +120,46 @@ pub fn measure(x: &[f64], d: &[f64], threshold: f64, origin: f64, deficit: &mut 
     m.process_zone = (damaged - m.debonded).max(0.0);
     m
 }
+
+/// Crack measures from the interface segments ([`super::segment`]) and the fronts the last
+/// assembly found in them, `damage(i)` the damage of point `i`.
+///
+/// A segment counts as failed (damaged) from its failed (damaged) end up to the failure (onset)
+/// front inside it, so the measures move continuously with the fronts: failed means damage 1 here,
+/// the level at which the segment rule places its failure front. Without a front between a failed
+/// and an intact end (a front the rule could not place, e.g. after unloading) half the segment
+/// counts.
+pub fn from_segments(
+    segments: &[super::segment::Segment],
+    fronts: &[[Option<f64>; 2]],
+    damage: impl Fn(usize) -> f64,
+    origin: f64,
+) -> CrackMeasures {
+    let mut m = CrackMeasures { tip: origin, ..Default::default() };
+    let mut damaged = 0.0;
+    for (s, fr) in segments.iter().zip(fronts) {
+        let (da, db) = (damage(s.a), damage(s.b));
+        let part = |ea: bool, eb: bool, front: Option<f64>| -> (f64, f64) {
+            // Fraction of the segment on the side of the ends where the property holds, and the
+            // right end of that part (fraction).
+            match (ea, eb) {
+                (true, true) => (1.0, 1.0),
+                (false, false) => (0.0, 0.0),
+                (true, false) => {
+                    let e = front.unwrap_or(0.5);
+                    (e, e)
+                }
+                (false, true) => (1.0 - front.unwrap_or(0.5), 1.0),
+            }
+        };
+        let (failed, right) = part(da >= 1.0, db >= 1.0, fr[1]);
+        let (dmg, _) = part(da > 0.0, db > 0.0, fr[0]);
+        m.debonded += failed * s.len;
+        damaged += dmg * s.len;
+        if failed > 0.0 {
+            m.tip = m.tip.max(s.x + right * s.len);
+        }
+    }
+    m.process_zone = (damaged - m.debonded).max(0.0);
+    m
+}

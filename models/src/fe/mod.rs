@@ -5,15 +5,18 @@
 //! * [`beam`]: the two-node shear-locking-free Timoshenko element (small rotations);
 //! * [`corotational`]: the same element under large rotations (co-rotational);
 //! * [`interface`]: gap kinematics of nodal interface points, contact;
+//! * [`segment`]: exact integration of the interface between points, with kinks at damage fronts;
 //! * [`assembly`]: the discrete problem and assembly of forces and tangent;
 //! * [`banded`]: band LU factorisation (the linear solver);
 //! * [`newton`]: Newton–Raphson under displacement or dissipation control;
 //! * [`path`]: path following (adaptive steps, output grid, snap-back detours);
+//! * `window`: the solution restricted to the nodes around a crack front, the linear regions
+//!   behind and ahead condensed exactly (used by [`path::run_with`]);
 //! * [`energy`]: external work, elastic and dissipated energy;
 //! * [`crack`]: debonded length, process zone and crack tip from the damage profile.
 //!
 //! Forward models ([`crate::dcb`], [`crate::enf`]) build an [`assembly::FeProblem`] from their
-//! configuration and call [`path::run`].
+//! configuration and call [`path::run_with`] (or [`path::run`]: nodal rule, every step recorded).
 
 // The kernels index small fixed-size arrays (element and point matrices) by position; index loops
 // state the algebra more plainly than iterator chains there.
@@ -29,9 +32,11 @@ pub mod interface;
 pub mod mesh;
 pub mod newton;
 pub mod path;
+pub mod segment;
+pub(crate) mod window;
 
-pub use assembly::{FeProblem, Spring};
+pub use assembly::{FeProblem, InterfaceRule, Spring};
 pub use interface::{InterfacePoint, PointKind};
 pub use mesh::{Layer, Mesh, Section};
 pub use newton::NewtonSettings;
-pub use path::{run, PathSettings, RunStats, StepRow};
+pub use path::{run, run_with, PathSettings, RunOptions, RunStats, StepRow};

@@ -3,7 +3,7 @@
 
 use czid_core::{CohesiveLaw, LawState};
 
-use super::assembly::{Assembler, FeProblem};
+use super::assembly::{Assembler, FeProblem, InterfaceRule};
 use super::banded::BandMatrix;
 
 /// Convergence settings.
@@ -47,12 +47,20 @@ pub struct Newton {
     pub settings: NewtonSettings,
     /// Total iterations (assemblies) and factorisations so far, for profiling.
     pub counters: (usize, usize),
+    /// Under displacement control, halve a correction that increased the residual and iterate
+    /// with secant stiffnesses for a while (on by default).
+    pub safeguard: bool,
 }
 
 impl Newton {
     /// Workspace for problem `p`.
     pub fn new(p: &FeProblem, law: &dyn CohesiveLaw, settings: NewtonSettings) -> Self {
-        let asm = Assembler::new(p, law);
+        Self::with_rule(p, law, settings, InterfaceRule::Nodal)
+    }
+
+    /// [`Newton::new`] with the interface integrated by `rule`.
+    pub fn with_rule(p: &FeProblem, law: &dyn CohesiveLaw, settings: NewtonSettings, rule: InterfaceRule) -> Self {
+        let asm = Assembler::with_rule(p, law, rule);
         let n = asm.n();
         let mut fixed_mask = vec![false; n];
         for &d in &p.fixed {
@@ -67,6 +75,7 @@ impl Newton {
             fixed_mask,
             settings,
             counters: (0, 0),
+            safeguard: true,
         }
     }
 
@@ -128,7 +137,7 @@ impl Newton {
             if rmax <= tol || (stalled && rmax <= 1e4 * tol) {
                 return Ok(it);
             }
-            if rmax > r_prev && alpha > 0.3 {
+            if self.safeguard && rmax > r_prev && alpha > 0.3 {
                 alpha *= 0.5;
                 for (qi, di) in q.iter_mut().zip(&self.b) {
                     *qi -= alpha * di;

@@ -1,0 +1,430 @@
+//! Interface segments: the cohesive interface between two neighbouring points, integrated exactly
+//! over a traction field that is linear between the points and between the fronts where the law's
+//! response has a kink.
+//!
+//! **Why.** With the nodal rule every point carries a whole tributary length, so a crack front
+//! advances one point at a time. For laws whose dissipation rate switches on and off abruptly (a
+//! linear elastic branch ending at the strength, softening that ends at complete failure: the
+//! sawtooth and bilinear laws), the energy the interface absorbs per unit crack growth then
+//! oscillates with the front's position between two points, by a fraction of the order of
+//! (point spacing / process zone). A DCB loaded in displacement control is only stable if that
+//! resistance varies slower than `4 G / a` per unit crack length: the oscillation is of the same
+//! order in the spacing, so refining the mesh does not remove the resulting snap-backs, and the
+//! load at a fixed opening becomes a discontinuous function of every parameter.
+//!
+//! **What.** Between points `a` and `b` the gap is interpolated linearly, `g(η) = (1 − η) g_a + η g_b`.
+//! The traction is taken linear in `η` between the points' own tractions, except that it passes
+//! through the law's values at the two fronts a segment may contain:
+//!
+//! * the *onset front*, where the gap leaves the initial elastic domain (one point damaged, the
+//!   other intact), with the elastic traction there;
+//! * the *failure front*, where the material reaches complete failure (one point failed, the
+//!   other not), with the traction of failed material (zero in opening).
+//!
+//! For a law that is piecewise linear along the loading path (sawtooth, bilinear) and a linear gap,
+//! this traction field is exact. The nodal forces `∫ N_i T dx` are integrated exactly over it (Simpson
+//! per piece). A front moves continuously with the gaps, and when it reaches a point it becomes that
+//! point's own kink: forces are continuous functions of the unknowns and the resistance to crack
+//! growth no longer depends on where the front lies between points.
+//!
+//! **Where the fronts are.** In pure mode I (both points with exactly zero slip, a positive opening)
+//! the fronts are at fixed openings, the law's elastic limit and failure opening, found once per run
+//! ([`ModeOne`]); elsewhere along the segment by bisection on the law's damage. Material between
+//! the points is assumed to have been loaded monotonically (the state of a front is the virgin
+//! state for the onset, the intact neighbour's committed state for failure), which holds where
+//! cracks grow.
+
+use czid_core::{CohesiveLaw, Gap, LawState, Tangent, Traction};
+
+use super::interface::{InterfacePoint, PointKind};
+use super::mesh::Mesh;
+
+/// The interface between two cohesive points of the same layers at neighbouring nodes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Segment {
+    /// Left point (index into the problem's points).
+    pub a: usize,
+    /// Right point.
+    pub b: usize,
+    /// Axial coordinate of the left point (mm).
+    pub x: f64,
+    /// Length (mm).
+    pub len: f64,
+    /// Interface area of the segment times the energy share of the points (mm²).
+    pub weight: f64,
+}
+
+/// The segments of `points`, and for each point whether a segment covers it (a covered point is
+/// integrated through its segments only; the others keep the nodal rule).
+///
+/// Points of the same layers, kind and energy share at neighbouring nodes form a segment. The area
+/// of a point is split between its two sides in proportion to their lengths (the nodal rule gives
+/// each point half of each neighbouring element), so the segments carry exactly the points' areas.
+pub fn segments(mesh: &Mesh, points: &[InterfacePoint]) -> (Vec<Segment>, Vec<bool>) {
+    // Cohesive points by interface (layers and energy share) and node.
+    let key = |p: &InterfacePoint| (p.upper, p.lower, p.factor.to_bits());
+    let nn = mesh.x.len();
+    let mut keys: Vec<(usize, Option<usize>, u64)> = Vec::new();
+    let mut by_node: Vec<Vec<usize>> = Vec::new();
+    let mut line = vec![usize::MAX; points.len()];
+    for (i, p) in points.iter().enumerate() {
+        if p.kind != PointKind::Cohesive {
+            continue;
+        }
+        let k = key(p);
+        let l = match keys.iter().position(|x| *x == k) {
+            Some(l) => l,
+            None => {
+                keys.push(k);
+                by_node.push(vec![usize::MAX; nn]);
+                keys.len() - 1
+            }
+        };
+        by_node[l][p.node] = i;
+        line[i] = l;
+    }
+    let neighbour = |i: usize, right: bool| -> Option<usize> {
+        let p = &points[i];
+        if line[i] == usize::MAX {
+            return None;
+        }
+        let node = if right { p.node + 1 } else { p.node.checked_sub(1)? };
+        let j = *by_node[line[i]].get(node)?;
+        (j != usize::MAX).then_some(j)
+    };
+    let len = |node: usize| mesh.x[node + 1] - mesh.x[node];
+    let share = |i: usize, right: bool| -> f64 {
+        let p = &points[i];
+        let l = neighbour(i, false).map_or(0.0, |_| len(p.node - 1));
+        let r = neighbour(i, true).map_or(0.0, |_| len(p.node));
+        p.area * if right { r } else { l } / (l + r)
+    };
+    let mut out = Vec::new();
+    let mut covered = vec![false; points.len()];
+    for (i, p) in points.iter().enumerate() {
+        if let Some(j) = neighbour(i, true) {
+            out.push(Segment {
+                a: i,
+                b: j,
+                x: mesh.x[p.node],
+                len: len(p.node),
+                weight: (share(i, true) + share(j, false)) * p.factor,
+            });
+            covered[i] = true;
+            covered[j] = true;
+        }
+    }
+    (out, covered)
+}
+
+/// A law's fronts on the pure mode I opening path from the virgin state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeOne {
+    /// Largest opening at which the virgin law is still undamaged (mm).
+    pub onset: f64,
+    /// Its traction and tangent.
+    pub onset_traction: Traction,
+    pub onset_tangent: Tangent,
+    /// Smallest opening at which the law reports complete failure (mm), if any.
+    pub failure: Option<f64>,
+    /// Traction and tangent of failed material at that opening.
+    pub failure_traction: Traction,
+    pub failure_tangent: Tangent,
+}
+
+impl ModeOne {
+    /// Finds the fronts by bisection to round-off; `None` if the law damages from the first
+    /// opening on (no elastic domain, hence no onset kink).
+    pub fn of(law: &dyn CohesiveLaw) -> Option<ModeOne> {
+        let init = law.initial_state();
+        let damage = |g: f64| law.evaluate(&Gap::new(g, 0.0), &init).state.damage;
+        let [k, _] = law.initial_stiffness();
+        let [s, _] = law.strength();
+        let mut hi = if k > 0.0 && s > 0.0 { s / k } else { 1e-6 };
+        let mut doublings = 0;
+        while damage(hi) <= 0.0 {
+            hi *= 2.0;
+            doublings += 1;
+            if doublings > 80 {
+                return None;
+            }
+        }
+        let onset = bisect(0.0, hi, |g| damage(g) > 0.0);
+        if onset <= 0.0 || onset.is_nan() {
+            return None;
+        }
+        let at_onset = law.evaluate(&Gap::new(onset, 0.0), &init);
+        let gc = law.fracture_energy()[0];
+        let mut hi = if gc > 0.0 && s > 0.0 { (2.0 * gc / s).max(2.0 * onset) } else { 2.0 * onset };
+        let mut failure = None;
+        for _ in 0..80 {
+            if damage(hi) >= 1.0 {
+                failure = Some(bisect(onset, hi, |g| damage(g) >= 1.0));
+                break;
+            }
+            hi *= 2.0;
+        }
+        // Failed side of the front (the bisection returns the last opening below it).
+        let at_failure = failure.map(|g| law.evaluate(&Gap::new(next_up(g), 0.0), &init));
+        Some(ModeOne {
+            onset,
+            onset_traction: at_onset.traction,
+            onset_tangent: at_onset.tangent,
+            failure,
+            failure_traction: at_failure.map_or(Traction::zeros(), |e| e.traction),
+            failure_tangent: at_failure.map_or(Tangent::zeros(), |e| e.tangent),
+        })
+    }
+}
+
+/// The point of `[lo, hi]` where `beyond` switches from false (at `lo`) to true (at `hi`), to
+/// round-off: the last value for which it is false.
+fn bisect(mut lo: f64, mut hi: f64, beyond: impl Fn(f64) -> bool) -> f64 {
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if beyond(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    lo
+}
+
+fn next_up(v: f64) -> f64 {
+    f64::from_bits(v.to_bits() + 1)
+}
+
+/// A front inside a segment: its position and the traction there, with their derivatives with
+/// respect to the two end gaps.
+#[derive(Clone, Copy, Debug)]
+struct Front {
+    eta: f64,
+    t: Traction,
+    /// `∂η/∂g_a`, `∂η/∂g_b`.
+    deta: [[f64; 2]; 2],
+    /// `∂T/∂g_a`, `∂T/∂g_b`.
+    dt: [Tangent; 2],
+}
+
+/// What a segment contributes: forces on its end gaps (the work-conjugates of `g_a`, `g_b`) and
+/// their Jacobian with respect to the end gaps.
+#[derive(Clone, Copy, Debug)]
+pub struct SegmentForces {
+    /// Force on `g_a` and on `g_b` (N).
+    pub f: [Traction; 2],
+    /// `∂f_i/∂g_j` (N/mm).
+    pub jac: [[Tangent; 2]; 2],
+    /// Position (fraction from `a`) of the onset front and of the failure front, if inside.
+    pub fronts: [Option<f64>; 2],
+    /// `∫ ½ T·g` over the segment (N·mm): its recoverable energy for laws that unload along the
+    /// secant (the default of [`CohesiveLaw::stored_energy`]).
+    pub stored: f64,
+}
+
+/// One end of a segment as the assembly sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct End<'a> {
+    /// Gap.
+    pub gap: Gap,
+    /// Trial traction.
+    pub t: Traction,
+    /// Iteration tangent.
+    pub d: Tangent,
+    /// Trial damage.
+    pub damage: f64,
+    /// Committed state.
+    pub state: &'a LawState,
+}
+
+/// Forces of segment `s` with ends `a`, `b` (see the module documentation).
+pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one: Option<&ModeOne>) -> SegmentForces {
+    let w = s.weight;
+    let mut fronts = [None, None];
+    let mut kinks: [Option<Front>; 2] = [None, None];
+    let pure_one = a.gap[1] == 0.0 && b.gap[1] == 0.0 && a.gap[0] > 0.0 && b.gap[0] > 0.0;
+    let init = law.initial_state();
+    // Onset front: one end damaged, the other never damaged.
+    let (da, db) = (a.damage > 0.0, b.damage > 0.0);
+    if da != db {
+        let intact = if da { b } else { a };
+        if intact.state.damage <= 0.0 {
+            kinks[0] = match (pure_one, mode_one) {
+                (true, Some(m)) => fixed_opening(a, b, m.onset, m.onset_traction, &m.onset_tangent),
+                _ => located(a, b, &|g| law.evaluate(g, &init), |e| e.state.damage > 0.0, !da, true),
+            };
+        }
+    }
+    // Failure front: one end failed, the other not.
+    let (fa, fb) = (a.damage >= 1.0, b.damage >= 1.0);
+    if fa != fb {
+        let other = if fa { b } else { a };
+        kinks[1] = match (pure_one, mode_one.and_then(|m| m.failure.map(|g| (g, m)))) {
+            (true, Some((g, m))) => fixed_opening(a, b, g, m.failure_traction, &m.failure_tangent),
+            _ => located(a, b, &|g| law.evaluate(g, other.state), |e| e.state.damage >= 1.0, !fa, false),
+        };
+    }
+    if kinks[0].is_none() && kinks[1].is_none() {
+        let (ta, tb) = (a.t, b.t);
+        return SegmentForces {
+            f: [(ta * 2.0 + tb) * (w / 6.0), (ta + tb * 2.0) * (w / 6.0)],
+            jac: [[a.d * (w / 3.0), b.d * (w / 6.0)], [a.d * (w / 6.0), b.d * (w / 3.0)]],
+            fronts,
+            stored: half_product(1.0, ta, tb, a.gap, b.gap) * w,
+        };
+    }
+    for (slot, k) in fronts.iter_mut().zip(&kinks) {
+        *slot = k.map(|k| k.eta);
+    }
+    // Breakpoints along η: the ends and the fronts, in order.
+    let mut inner: Vec<Front> = kinks.iter().flatten().copied().collect();
+    inner.sort_by(|x, y| x.eta.total_cmp(&y.eta));
+    let n = inner.len() + 2;
+    let mut xs = [0.0; 4];
+    let mut ts = [Traction::zeros(); 4];
+    xs[0] = 0.0;
+    ts[0] = a.t;
+    for (k, fr) in inner.iter().enumerate() {
+        xs[k + 1] = fr.eta;
+        ts[k + 1] = fr.t;
+    }
+    xs[n - 1] = 1.0;
+    ts[n - 1] = b.t;
+    // f_a = w Σ ∫ (1 − η) T dη, f_b = w Σ ∫ η T dη over pieces with linear T; and the
+    // coefficients of each breakpoint's traction and position.
+    let mut f = [Traction::zeros(); 2];
+    let mut ct = [[0.0; 4]; 2]; // ∂f_i/∂T_k (scalar, per component)
+    let mut cx = [[Traction::zeros(); 4]; 2]; // ∂f_i/∂x_k
+    for p in 0..n - 1 {
+        let (x0, x1, t0, t1) = (xs[p], xs[p + 1], ts[p], ts[p + 1]);
+        let l = x1 - x0;
+        for (i, (n0, n1)) in [(1.0 - x0, 1.0 - x1), (x0, x1)].into_iter().enumerate() {
+            // ∫ N T over the piece, N and T linear: l/6 [2 N0 T0 + N0 T1 + N1 T0 + 2 N1 T1].
+            let bracket = t0 * (2.0 * n0 + n1) + t1 * (n0 + 2.0 * n1);
+            f[i] += bracket * (l / 6.0);
+            ct[i][p] += l / 6.0 * (2.0 * n0 + n1);
+            ct[i][p + 1] += l / 6.0 * (n0 + 2.0 * n1);
+            // dN/dx = −1 for f_a, +1 for f_b.
+            let dn = if i == 0 { -1.0 } else { 1.0 };
+            cx[i][p] += -bracket / 6.0 + (t0 * 2.0 + t1) * (dn * l / 6.0);
+            cx[i][p + 1] += bracket / 6.0 + (t0 + t1 * 2.0) * (dn * l / 6.0);
+        }
+    }
+    let dg = b.gap - a.gap;
+    let stored: f64 = (0..n - 1)
+        .map(|p| half_product(xs[p + 1] - xs[p], ts[p], ts[p + 1], a.gap + dg * xs[p], a.gap + dg * xs[p + 1]))
+        .sum();
+    let mut jac = [[Tangent::zeros(); 2]; 2];
+    for i in 0..2 {
+        jac[i][0] = a.d * ct[i][0];
+        jac[i][1] = b.d * ct[i][n - 1];
+        for (k, fr) in inner.iter().enumerate() {
+            for j in 0..2 {
+                jac[i][j] += fr.dt[j] * ct[i][k + 1];
+                let c = cx[i][k + 1];
+                for r in 0..2 {
+                    for col in 0..2 {
+                        jac[i][j][(r, col)] += c[r] * fr.deta[j][col];
+                    }
+                }
+            }
+        }
+    }
+    SegmentForces {
+        f: [f[0] * w, f[1] * w],
+        jac: [[jac[0][0] * w, jac[0][1] * w], [jac[1][0] * w, jac[1][1] * w]],
+        fronts,
+        stored: stored * w,
+    }
+}
+
+/// `∫ ½ T·g` over a piece of length `l` (fraction of the segment) on which `T` and `g` are linear.
+fn half_product(l: f64, t0: Traction, t1: Traction, g0: Gap, g1: Gap) -> f64 {
+    l / 12.0 * (2.0 * t0.dot(&g0) + t0.dot(&g1) + t1.dot(&g0) + 2.0 * t1.dot(&g1))
+}
+
+/// A front at the fixed opening `g` on a pure mode I segment, if it lies strictly between the ends;
+/// `t`, `k` the traction and tangent there.
+fn fixed_opening(a: &End, b: &End, g: f64, t: Traction, k: &Tangent) -> Option<Front> {
+    let (ga, gb) = (a.gap[0], b.gap[0]);
+    if (ga - g) * (gb - g) >= 0.0 || ga.is_nan() || gb.is_nan() {
+        return None;
+    }
+    let d = ga - gb;
+    let eta = (ga - g) / d;
+    let deta = [[(g - gb) / (d * d), 0.0], [(ga - g) / (d * d), 0.0]];
+    Some(Front { eta, t, deta, dt: front_tangents(k, eta, b.gap - a.gap, &deta) })
+}
+
+/// `∂T/∂g_j` of a front's traction, the law's tangent `k` times `∂g(η)/∂g_j = c_j I + Δg ⊗ ∂η/∂g_j`.
+fn front_tangents(k: &Tangent, eta: f64, dg: Gap, deta: &[[f64; 2]; 2]) -> [Tangent; 2] {
+    let mut dt = [Tangent::zeros(); 2];
+    for (j, c) in [1.0 - eta, eta].into_iter().enumerate() {
+        let mut dgj = Tangent::identity() * c;
+        for r in 0..2 {
+            for col in 0..2 {
+                dgj[(r, col)] += dg[r] * deta[j][col];
+            }
+        }
+        dt[j] = k * dgj;
+    }
+    dt
+}
+
+/// A front located by bisection along the segment: `beyond` holds for the law's response at the
+/// end `a` (if `from_a` is false, at `b`) and not at the other. Its derivatives need the normal to
+/// the front in gap space: the gradient of the damage on the side where it varies (`grows_beyond`:
+/// beyond the front for the onset, before it for failure), by central differences; the radial
+/// direction if that gradient vanishes.
+fn located(
+    a: &End,
+    b: &End,
+    eval: &dyn Fn(&Gap) -> czid_core::LawEval,
+    beyond: impl Fn(&czid_core::LawEval) -> bool,
+    from_a: bool,
+    grows_beyond: bool,
+) -> Option<Front> {
+    let gap = |eta: f64| a.gap * (1.0 - eta) + b.gap * eta;
+    // Orient the search so that `beyond` is false at 0 and true at 1 in `s`.
+    let to_eta = |s: f64| if from_a { s } else { 1.0 - s };
+    if beyond(&eval(&gap(to_eta(0.0)))) || !beyond(&eval(&gap(to_eta(1.0)))) {
+        return None;
+    }
+    let s = bisect(0.0, 1.0, |s| beyond(&eval(&gap(to_eta(s)))));
+    let eta = to_eta(s);
+    if !(eta > 0.0 && eta < 1.0) {
+        return None;
+    }
+    let g = gap(eta);
+    let at = eval(&g);
+    let norm = g.norm();
+    let dg = b.gap - a.gap;
+    let mut deta = [[0.0; 2]; 2];
+    let mut dt = [Tangent::zeros(); 2];
+    if norm > 0.0 {
+        // A point a little on the side where the damage varies, and the damage's gradient there.
+        let h = 1e-6 * norm;
+        let side = if grows_beyond == from_a { 1.0 } else { -1.0 };
+        let toward = dg * (side / dg.norm().max(1e-300));
+        let probe = g + toward * (4.0 * h);
+        let dmg = |x: Gap| eval(&x).state.damage;
+        let grad = Gap::new(
+            dmg(probe + Gap::new(h, 0.0)) - dmg(probe - Gap::new(h, 0.0)),
+            dmg(probe + Gap::new(0.0, h)) - dmg(probe - Gap::new(0.0, h)),
+        );
+        let nrm = if grad.norm() > 0.0 && grad.iter().all(|v| v.is_finite()) { grad / grad.norm() } else { g / norm };
+        let den = nrm.dot(&dg);
+        if den != 0.0 {
+            for (j, c) in [1.0 - eta, eta].into_iter().enumerate() {
+                for r in 0..2 {
+                    deta[j][r] = -c * nrm[r] / den;
+                }
+            }
+            dt = front_tangents(&at.tangent, eta, dg, &deta);
+        }
+    }
+    Some(Front { eta, t: at.traction, deta, dt })
+}
