@@ -400,9 +400,34 @@ impl<const D: usize> Layout<D> {
                 };
                 let (da, db) = (mesh.dofs(l, i), mesh.dofs(l, i + 1));
                 let ed = [da[0], da[1], da[2], db[0], db[1], db[2]];
+                if ed.iter().any(|&g| g != NONE && (g == c || fixed[g])) {
+                    // Near the loaded end: route entries of the control and fixed unknowns.
+                    for r in 0..6 {
+                        for s in 0..6 {
+                            put(&mut lay, ed[r], ed[s], ke[r][s], Some(i))?;
+                        }
+                    }
+                    continue;
+                }
+                // Elsewhere the element's unknowns are the two nodes' own: add its blocks.
+                let local: [Option<usize>; 6] = std::array::from_fn(|r| (ed[r] != NONE).then(|| owner[ed[r]].1));
                 for r in 0..6 {
+                    let Some(lr) = local[r] else { continue };
                     for s in 0..6 {
-                        put(&mut lay, ed[r], ed[s], ke[r][s], Some(i))?;
+                        let Some(ls) = local[s] else { continue };
+                        let v = ke[r][s];
+                        match (r < 3, s < 3) {
+                            (true, true) => {
+                                lay.kd[i][lr][ls] += v;
+                                lay.ed0[i][lr][ls] += v;
+                            }
+                            (false, false) => {
+                                lay.kd[i + 1][lr][ls] += v;
+                                lay.ed1[i][lr][ls] += v;
+                            }
+                            (true, false) => lay.ku[i][lr][ls] += v,
+                            (false, true) => lay.kl[i][lr][ls] += v,
+                        }
                     }
                 }
             }
