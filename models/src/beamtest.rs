@@ -114,7 +114,10 @@ pub struct ControlSettings {
     /// Number of equally spaced displacements at which a state is always recorded (more rows
     /// appear where steps were refined).
     pub output_points: usize,
-    /// Damage at or above which the interface counts as debonded.
+    /// Damage at or above which the interface counts as debonded. Models integrating the
+    /// interface by segments place the debonded front between points where the damage reaches it
+    /// (from `1 − 10⁻⁶` on: where the law reports complete failure, see
+    /// [`crate::fe::crack::FAILURE_LEVEL`]).
     pub damage_threshold: f64,
     /// Newton iterations allowed per step before it is cut.
     pub max_iterations: usize,

@@ -207,3 +207,31 @@ fn windowed_solution_equals_the_whole_mesh_solution() {
         assert!(win.last().unwrap().crack.debonded > 1.0, "the crack ran");
     }
 }
+
+#[test]
+fn debonded_length_follows_the_damage_threshold() {
+    // A lower threshold counts part of the process zone as debonded: the debonded length grows by
+    // the distance between the fronts at damage 0.5 and at complete failure, the process zone
+    // shrinks by as much, and both the window and the whole mesh place that front alike.
+    let law = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap();
+    let mut d = Dcb::paper();
+    d.control.max_displacement = Some(4.0);
+    d.control.output_points = 20;
+    let (p, _) = d.problem().unwrap();
+    let run = |threshold: f64, window: bool| {
+        let mut path = paper_path(2.0, 20);
+        path.crack_origin = d.a0;
+        path.damage_threshold = threshold;
+        let o = RunOptions { interface: InterfaceRule::Segments, outputs_only: true, window };
+        fe::run_with(&p, &law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error)).0
+    };
+    let (full, half, half_whole) = (run(1.0 - 1e-9, true), run(0.5, true), run(0.5, false));
+    let (a, b, c) = (full.last().unwrap().crack, half.last().unwrap().crack, half_whole.last().unwrap().crack);
+    println!(
+        "debonded {:.4} mm (complete failure), {:.4} mm (damage 0.5); process zone {:.4} / {:.4}",
+        a.debonded, b.debonded, a.process_zone, b.process_zone
+    );
+    assert!(b.debonded > a.debonded && b.debonded < a.debonded + a.process_zone);
+    assert!((a.debonded + a.process_zone - b.debonded - b.process_zone).abs() < 1e-9);
+    assert!((b.debonded - c.debonded).abs() < 1e-6);
+}

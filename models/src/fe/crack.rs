@@ -121,42 +121,53 @@ pub fn measure(x: &[f64], d: &[f64], threshold: f64, origin: f64, deficit: &mut 
     m
 }
 
+/// Damage thresholds at least this close to 1 count as complete failure with segments: the
+/// debonded front is then the failure front the segment rule places anyway (for the bundled laws
+/// it lies within 10⁻⁹ of the opening where the damage reaches `1 − 10⁻⁹`).
+pub const FAILURE_LEVEL: f64 = 1.0 - 1e-6;
+
 /// Crack measures from the interface segments ([`super::segment`]) and the fronts the last
 /// assembly found in them, `damage(i)` the damage of point `i`.
 ///
-/// A segment counts as failed (damaged) from its failed (damaged) end up to the failure (onset)
-/// front inside it, so the measures move continuously with the fronts: failed means damage 1 here,
-/// the level at which the segment rule places its failure front. Without a front between a failed
-/// and an intact end (a front the rule could not place, e.g. after unloading) half the segment
-/// counts.
+/// A segment counts as debonded (damaged) from its debonded (damaged) end up to the debonded
+/// (onset) front inside it, so the measures move continuously with the fronts. Debonded means
+/// damage at or above `threshold`; for thresholds from [`FAILURE_LEVEL`] on, that is complete
+/// failure and the front is the segment rule's failure front; below, `level_front(k)` places it
+/// in segment `k` (see [`super::segment::level_front`]). Without a front between a debonded and an
+/// intact end (one that could not be placed, e.g. after unloading) half the segment counts.
 pub fn from_segments(
     segments: &[super::segment::Segment],
     fronts: &[[Option<f64>; 2]],
     damage: impl Fn(usize) -> f64,
     origin: f64,
+    threshold: f64,
+    level_front: impl Fn(usize) -> Option<f64>,
 ) -> CrackMeasures {
     let mut m = CrackMeasures { tip: origin, ..Default::default() };
     let mut damaged = 0.0;
-    for (s, fr) in segments.iter().zip(fronts) {
+    let failure = threshold >= FAILURE_LEVEL;
+    let level = if failure { 1.0 } else { threshold };
+    for (k, (s, fr)) in segments.iter().zip(fronts).enumerate() {
         let (da, db) = (damage(s.a), damage(s.b));
-        let part = |ea: bool, eb: bool, front: Option<f64>| -> (f64, f64) {
+        let part = |ea: bool, eb: bool, front: &dyn Fn() -> Option<f64>| -> (f64, f64) {
             // Fraction of the segment on the side of the ends where the property holds, and the
             // right end of that part (fraction).
             match (ea, eb) {
                 (true, true) => (1.0, 1.0),
                 (false, false) => (0.0, 0.0),
                 (true, false) => {
-                    let e = front.unwrap_or(0.5);
+                    let e = front().unwrap_or(0.5);
                     (e, e)
                 }
-                (false, true) => (1.0 - front.unwrap_or(0.5), 1.0),
+                (false, true) => (1.0 - front().unwrap_or(0.5), 1.0),
             }
         };
-        let (failed, right) = part(da >= 1.0, db >= 1.0, fr[1]);
-        let (dmg, _) = part(da > 0.0, db > 0.0, fr[0]);
-        m.debonded += failed * s.len;
+        let debond_front = || if failure { fr[1] } else { level_front(k) };
+        let (debonded, right) = part(da >= level, db >= level, &debond_front);
+        let (dmg, _) = part(da > 0.0, db > 0.0, &|| fr[0]);
+        m.debonded += debonded * s.len;
         damaged += dmg * s.len;
-        if failed > 0.0 {
+        if debonded > 0.0 {
             m.tip = m.tip.max(s.x + right * s.len);
         }
     }

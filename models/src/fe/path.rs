@@ -243,7 +243,28 @@ pub fn run_with(
                     for (d, st) in all_damage.iter_mut().zip(&cur.states) {
                         *d = st.damage;
                     }
-                    crack::from_segments(&nw.asm.segments, &nw.asm.fronts, |i| all_damage[i], s.crack_origin)
+                    {
+                        let (segs, gaps, st) = (&nw.asm.segments, &nw.asm.gaps, &cur.states);
+                        let level = |k: usize| {
+                            let sg = &segs[k];
+                            super::segment::level_front(
+                                law,
+                                gaps[sg.a],
+                                gaps[sg.b],
+                                &st[sg.a],
+                                &st[sg.b],
+                                s.damage_threshold,
+                            )
+                        };
+                        crack::from_segments(
+                            segs,
+                            &nw.asm.fronts,
+                            |i| all_damage[i],
+                            s.crack_origin,
+                            s.damage_threshold,
+                            level,
+                        )
+                    }
                 } else {
                     for (d, &i) in dmg.iter_mut().zip(&cohesive) {
                         *d = cur.states[i].damage;

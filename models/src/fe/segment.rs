@@ -428,3 +428,25 @@ fn located(
     }
     Some(Front { eta, t: at.traction, deta, dt })
 }
+
+/// Where along the segment between points with gaps `ga`, `gb` and committed states `sa`, `sb`
+/// the damage reaches `level` (a fraction from `a`), if one end is at or above it and the other
+/// below: bisection on the law evaluated from the less damaged end's state (the material between
+/// loaded monotonically, as for the failure front).
+pub fn level_front(law: &dyn CohesiveLaw, ga: Gap, gb: Gap, sa: &LawState, sb: &LawState, level: f64) -> Option<f64> {
+    let (da, db) = (law.evaluate(&ga, sa).state.damage, law.evaluate(&gb, sb).state.damage);
+    if (da >= level) == (db >= level) {
+        return None;
+    }
+    let (from, state) = if da < level { (0.0, sa) } else { (1.0, sb) };
+    let gap = |eta: f64| ga * (1.0 - eta) + gb * eta;
+    let beyond = |s: f64| {
+        let eta = if from == 0.0 { s } else { 1.0 - s };
+        law.evaluate(&gap(eta), state).state.damage >= level
+    };
+    if !beyond(1.0) {
+        return None;
+    }
+    let s = bisect(0.0, 1.0, beyond);
+    Some(if from == 0.0 { s } else { 1.0 - s })
+}

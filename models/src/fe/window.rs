@@ -1105,7 +1105,14 @@ impl<'a, const D: usize> Solver<'a, D> {
         let (i0, i1) = (self.i0, self.i1);
         let (k0, k1) = (i0 - lay.first, i1 - lay.first);
         let damage = |i: usize| self.pts[i].state.damage;
-        let mut m = super::crack::from_segments(&lay.segs[k0..k1], &self.fronts[k0..k1], damage, self.s.crack_origin);
+        let level = |k: usize| {
+            let sg = &lay.segs[k0 + k];
+            let (a, b) = (&self.pts[sg.a], &self.pts[sg.b]);
+            segment::level_front(self.law, a.g, b.g, &a.state, &b.state, self.s.damage_threshold)
+        };
+        let (segs, fronts) = (&lay.segs[k0..k1], &self.fronts[k0..k1]);
+        let mut m =
+            super::crack::from_segments(segs, fronts, damage, self.s.crack_origin, self.s.damage_threshold, level);
         // The left region has failed all along.
         let failed_left = self.p.mesh.x[i0] - self.p.mesh.x[lay.first];
         if failed_left > 0.0 {
