@@ -8,9 +8,8 @@
 //! law's compression penalty, at a negative opening) and the co-rotational stiffening at large
 //! openings both bend the elastic unloading curve, so an elastic state can "release" τ. The record
 //! then jumped from 9 mm to a negative opening and unloaded to zero with the debonded length frozen
-//! (or the run failed with "no convergence at control -0.000…"). The two large-rotation tests are
-//! ignored until `fe/path.rs` rejects a dissipation-controlled step that damaged nothing (or
-//! reversed the load) like a failed one.
+//! (or the run failed with "no convergence at control -0.000…"). With smooth crack growth
+//! (interface segments) the crack no longer snaps back node by node and these runs follow the test.
 //!
 //! Expected values come from physics, not from the code:
 //! * under displacement control the recorded opening only moves back by the node-scale snap-backs
@@ -119,8 +118,6 @@ fn small_rotation_dcb01_follows_the_test_to_its_end() {
 }
 
 #[test]
-#[ignore = "large-rotation path following turns back after the peak: a dissipation-controlled step converges to an \
-            elastic root of the constraint (fe/path.rs accepts it); see the module documentation"]
 fn large_rotation_dcb01_follows_the_test_with_the_large_displacement_correction() {
     let small = run(&dcb01(false), "small rotations");
     let large = run(&dcb01(true), "large rotations");
@@ -162,8 +159,6 @@ fn large_rotation_dcb01_follows_the_test_with_the_large_displacement_correction(
 /// positive opening (about 9.5 mm of control from 14.6 mm), where only the co-rotational
 /// stiffening bends the elastic unloading curve.
 #[test]
-#[ignore = "large-rotation path following turns back after the peak: a dissipation-controlled step converges to an \
-            elastic root of the constraint (fe/path.rs accepts it); see the module documentation"]
 fn large_rotation_dcb01_follows_the_test_on_a_coarser_grid() {
     let mut d = dcb01(true);
     d.mesh.interface_element = 0.25;
