@@ -226,3 +226,32 @@ pub fn positive(owner: &str, name: &str, v: f64) -> Result<()> {
 pub fn non_negative(owner: &str, name: &str, v: f64) -> Result<()> {
     require_non_negative(owner, name, v)
 }
+
+impl ControlSettings {
+    /// Path-following settings to `target` (control unknown) with these output and Newton settings.
+    pub fn path(&self, target: f64, crack_origin: f64) -> crate::fe::PathSettings {
+        crate::fe::PathSettings {
+            target,
+            outputs: self.output_points,
+            min_step_fraction: 1e-3,
+            damage_threshold: self.damage_threshold,
+            crack_origin,
+            newton: crate::fe::NewtonSettings { max_iterations: self.max_iterations, tolerance: self.tolerance },
+        }
+    }
+}
+
+/// Runs an engine problem and converts its rows to a record, keeping the converged rows of a run
+/// that fails part way; also returns the engine's statistics on success.
+pub fn run(
+    p: &crate::fe::FeProblem,
+    law: &dyn czid_core::CohesiveLaw,
+    path: &crate::fe::PathSettings,
+    options: &crate::fe::RunOptions,
+    scale: &RowScale,
+) -> std::result::Result<(Record, crate::fe::RunStats), czid_core::SimulationFailure> {
+    match crate::fe::run_with(p, law, path, options) {
+        Ok((rows, stats)) => Ok((to_record(&rows, scale), stats)),
+        Err(f) => Err(czid_core::SimulationFailure { error: f.error, partial: to_record(&f.rows, scale) }),
+    }
+}

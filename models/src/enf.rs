@@ -17,9 +17,7 @@ use serde::{Deserialize, Serialize};
 use crate::beamtest::{self, ControlSettings, Material, MeshSettings, RowScale};
 use crate::effects::Effects;
 use crate::fe::mesh::{graded, NONE};
-use crate::fe::{
-    self, FeProblem, InterfacePoint, Layer, Mesh, NewtonSettings, PathSettings, PointKind, Section, Spring,
-};
+use crate::fe::{self, FeProblem, InterfacePoint, Layer, Mesh, PathSettings, PointKind, Section, Spring};
 
 /// ENF configuration. All lengths in mm, moduli in MPa.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -186,14 +184,7 @@ impl Enf {
     }
 
     fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
-        PathSettings {
-            target: self.max_deflection(law) / scale.displacement,
-            outputs: self.control.output_points,
-            min_step_fraction: 1e-3,
-            damage_threshold: self.control.damage_threshold,
-            crack_origin: self.effective_crack_length(),
-            newton: NewtonSettings { max_iterations: self.control.max_iterations, tolerance: self.control.tolerance },
-        }
+        self.control.path(self.max_deflection(law) / scale.displacement, self.effective_crack_length())
     }
 }
 
@@ -212,10 +203,7 @@ impl ForwardModel for Enf {
         law.validate().map_err(fail)?;
         let (p, scale) = self.problem(law).map_err(fail)?;
         let path = self.path(law, &scale);
-        match fe::run_with(&p, law, &path, &RUN) {
-            Ok((rows, _)) => Ok(beamtest::to_record(&rows, &scale)),
-            Err(f) => Err(SimulationFailure { error: f.error, partial: beamtest::to_record(&f.rows, &scale) }),
-        }
+        beamtest::run(&p, law, &path, &RUN, &scale).map(|(record, _)| record)
     }
 }
 
@@ -224,6 +212,5 @@ pub fn simulate_with_stats(enf: &Enf, law: &dyn CohesiveLaw) -> Result<(Record, 
     law.validate()?;
     let (p, scale) = enf.problem(law)?;
     let path = enf.path(law, &scale);
-    let (rows, stats) = fe::run_with(&p, law, &path, &RUN).map_err(|f| f.error)?;
-    Ok((beamtest::to_record(&rows, &scale), stats))
+    beamtest::run(&p, law, &path, &RUN, &scale).map_err(|f| f.error)
 }
