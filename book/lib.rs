@@ -23,3 +23,5 @@ pub mod quick_start {}
 pub mod paper_dcb {}
 #[doc = include_str!("src/real_dcb.md")]
 pub mod real_dcb {}
+#[doc = include_str!("src/diagnose.md")]
+pub mod diagnose {}
