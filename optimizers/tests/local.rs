@@ -51,3 +51,22 @@ fn local_method_starts_from_a_given_point() {
     let r = nm.minimize_from(&p, &Budget::evaluations(3000), &[0.9, 0.8], &mut NoObserver).unwrap();
     assert!(r.best.value < 1e-12, "{}", r.best.value);
 }
+
+/// Budgets smaller than a method's first batch (Nelder–Mead's initial simplex, a finite-difference
+/// gradient) and targets met within it end the run cleanly, never beyond the budget.
+#[test]
+fn tiny_budgets_and_early_targets_end_cleanly() {
+    let p = TestFunction::new(Function::Rosenbrock, 4).unwrap();
+    for m in METHODS {
+        let opt = optimizer_from_config(m, &toml::Value::Table(toml::Table::new())).unwrap();
+        for budget in 1..=7 {
+            let r = opt.minimize(&p, &Budget::evaluations(budget), 0, &mut NoObserver).unwrap();
+            assert!(r.evaluations <= budget, "{m}: {} evaluations for a budget of {budget}", r.evaluations);
+            assert!(r.evaluations >= 1, "{m}: no evaluation for a budget of {budget}");
+        }
+        // Any value meets this target: the run stops after its first batch of evaluations.
+        let early = Budget { evaluations: 1000, target: Some(f64::INFINITY) };
+        let r = opt.minimize(&p, &early, 0, &mut NoObserver).unwrap();
+        assert!(r.evaluations <= 9, "{m}: {} evaluations past a target met at once", r.evaluations);
+    }
+}

@@ -3,6 +3,7 @@
 use super::{local_optimizer, with_restarts, Ctx, LocalOptimizer, LocalSettings};
 use argmin::core::{CostFunction, Error, Executor};
 use czid_core::{Budget, Observer, OptimizationResult, Problem, Result};
+use std::cell::Cell;
 
 /// Nelder–Mead (registry name `nelder-mead`).
 #[derive(Clone, Debug)]
@@ -12,14 +13,26 @@ pub struct NelderMead {
 
 local_optimizer!(NelderMead, "nelder-mead");
 
-struct Cost<'c, 'a>(&'c Ctx<'a>);
+/// The cost seen by argmin. argmin evaluates the initial simplex with `unwrap`, so a refusal (budget
+/// spent, target reached, run stopped) during those first `n + 1` calls is reported as an infinitely
+/// bad vertex instead of an error; the refusal after them ends the run as usual.
+struct Cost<'c, 'a> {
+    ctx: &'c Ctx<'a>,
+    initial_vertices_left: Cell<usize>,
+}
 
 impl CostFunction for Cost<'_, '_> {
     type Param = Vec<f64>;
     type Output = f64;
 
     fn cost(&self, z: &Vec<f64>) -> std::result::Result<f64, Error> {
-        Ok(self.0.eval(std::slice::from_ref(z))?[0].value)
+        let in_simplex = self.initial_vertices_left.get() > 0;
+        self.initial_vertices_left.set(self.initial_vertices_left.get().saturating_sub(1));
+        match self.ctx.eval(std::slice::from_ref(z)) {
+            Ok(evaluations) => Ok(evaluations[0].value),
+            Err(_) if in_simplex => Ok(f64::INFINITY),
+            Err(e) => Err(e),
+        }
     }
 }
 
@@ -44,7 +57,8 @@ impl LocalOptimizer for NelderMead {
                 return;
             };
             // An error here only means that the run was stopped (budget, target, observer).
-            let _ = Executor::new(Cost(&ctx), solver).configure(|st| st.max_iters(s.max_iterations)).run();
+            let cost = Cost { ctx: &ctx, initial_vertices_left: Cell::new(ctx.dim() + 1) };
+            let _ = Executor::new(cost, solver).configure(|st| st.max_iters(s.max_iterations)).run();
         });
         ctx.finish()
     }
