@@ -175,7 +175,7 @@ impl Dcb {
     }
 
     fn section(&self, h: f64) -> Section {
-        Section { e: self.material.axial_modulus(), g: self.material.g13, b: self.width, h }
+        Section { e: self.material.axial_modulus(), g: self.effects.shear_modulus(self.material.g13), b: self.width, h }
     }
 
     /// Builds the discrete problem (mesh built per run: it costs well under 1 % of a run, and

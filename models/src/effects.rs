@@ -27,6 +27,11 @@ pub struct Effects {
     /// foundation of Kanninen's DCB model, which lets the crack-tip root rotate. A physical value is
     /// `h / (2 E22)`. 0: rigid through the thickness.
     pub root_compliance: f64,
+    /// Extra transverse shear compliance of the adherends (1/MPa), added to `1/G13`: the beams
+    /// deform in shear with `G = 1 / (1/G13 + shear_compliance)`. Represents more shear
+    /// deformation than the nominal G13 gives (a lower interlaminar shear modulus, resin-rich
+    /// layers). 0: the nominal G13.
+    pub shear_compliance: f64,
     /// Large rotations (co-rotational beams and interface frames) instead of small rotations.
     pub large_rotation: bool,
 }
@@ -36,6 +41,7 @@ impl Effects {
     pub fn validate(&self, owner: &str) -> Result<()> {
         require_non_negative(owner, "effects.machine_compliance", self.machine_compliance)?;
         require_non_negative(owner, "effects.root_compliance", self.root_compliance)?;
+        require_non_negative(owner, "effects.shear_compliance", self.shear_compliance)?;
         if !self.crack_length_offset.is_finite() {
             return Err(CzError::invalid(
                 owner,
@@ -53,5 +59,15 @@ impl Effects {
             ));
         }
         Ok(())
+    }
+
+    /// Shear modulus the beams use (MPa): `g13` itself when `shear_compliance` is 0 (the base
+    /// model's value, bit for bit), else `1 / (1/g13 + shear_compliance)`.
+    pub fn shear_modulus(&self, g13: f64) -> f64 {
+        if self.shear_compliance == 0.0 {
+            g13
+        } else {
+            1.0 / (1.0 / g13 + self.shear_compliance)
+        }
     }
 }

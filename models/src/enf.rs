@@ -109,12 +109,18 @@ impl Enf {
     }
 
     fn section(&self) -> Section {
-        Section { e: self.material.axial_modulus(), g: self.material.g13, b: self.width, h: self.h }
+        Section {
+            e: self.material.axial_modulus(),
+            g: self.effects.shear_modulus(self.material.g13),
+            b: self.width,
+            h: self.h,
+        }
     }
 
     /// Beam-theory compliance with shear, `C = (3a³ + 2L³)/(8 E b h³) + 3L/(10 G13 b h)` (mm/N).
     pub fn beam_compliance(&self, a: f64) -> f64 {
-        let (e, g, b, h, l) = (self.material.axial_modulus(), self.material.g13, self.width, self.h, self.half_span);
+        let g = self.effects.shear_modulus(self.material.g13);
+        let (e, b, h, l) = (self.material.axial_modulus(), self.width, self.h, self.half_span);
         (3.0 * a.powi(3) + 2.0 * l.powi(3)) / (8.0 * e * b * h.powi(3)) + 3.0 * l / (10.0 * g * b * h)
     }
 

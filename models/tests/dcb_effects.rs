@@ -32,7 +32,7 @@ fn null_effects_written_out_reproduce_the_base_model_bitwise() {
     let mut v = serde_json::to_value(&d).unwrap();
     v["effects"] = serde_json::json!({
         "machine_compliance": 0.0, "crack_length_offset": 0.0, "displacement_offset": 0.0,
-        "root_compliance": 0.0, "large_rotation": false
+        "root_compliance": 0.0, "shear_compliance": 0.0, "large_rotation": false
     });
     let explicit: Dcb = serde_json::from_value(v).unwrap();
     assert_eq!(run(&d, &law()), run(&explicit, &law()));
@@ -111,4 +111,36 @@ fn large_rotations_agree_with_small_ones_at_small_openings() {
     let (ps, pl) = (col(&rs, columns::LOAD)[1], col(&rl, columns::LOAD)[1]);
     println!("P at 0.25 mm: small {ps:.6}, large {pl:.6}");
     assert!((pl / ps - 1.0).abs() < 1e-3);
+}
+
+#[test]
+fn shear_compliance_equals_a_lower_shear_modulus() {
+    // 1/G = 1/G13 + s: the effect is the same arm with the combined modulus, exactly.
+    let s = 2e-4;
+    let mut a = base();
+    a.effects.shear_compliance = s;
+    let mut b = base();
+    b.material.g13 = 1.0 / (1.0 / b.material.g13 + s);
+    assert_eq!(run(&a, &law()), run(&b, &law()));
+    // And it makes the specimen more compliant: more shear deflection of the arms.
+    let (r0, r1) = (run(&base(), &law()), run(&a, &law()));
+    let (p0, p1) = (col(&r0, columns::LOAD)[1], col(&r1, columns::LOAD)[1]);
+    assert!(p1 < p0, "{p1} vs {p0}");
+}
+
+#[test]
+fn zero_shear_compliance_is_the_base_model_in_the_enf_too() {
+    use czid_models::enf::Enf;
+    let mut e = Enf::hartlen_enf03();
+    e.control.max_displacement = Some(1.0);
+    e.control.output_points = 5;
+    let mut v = serde_json::to_value(&e).unwrap();
+    v["effects"]["shear_compliance"] = serde_json::json!(0.0);
+    let explicit: Enf = serde_json::from_value(v).unwrap();
+    let law = TestBilinear::new(1e5, 60.0, 0.3);
+    assert_eq!(e.simulate(&law).unwrap(), explicit.simulate(&law).unwrap());
+    let mut s = e.clone();
+    s.effects.shear_compliance = 2e-4;
+    let (p0, p1) = (e.simulate(&law).unwrap(), s.simulate(&law).unwrap());
+    assert!(col(&p1, columns::LOAD)[1] < col(&p0, columns::LOAD)[1]);
 }
