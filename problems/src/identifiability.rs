@@ -21,6 +21,9 @@ const NEGLIGIBLE: f64 = 1e-6;
 const LOOSE: f64 = 0.25;
 /// Correlation above which two parameters are reported as traded against each other.
 const CORRELATED: f64 = 0.95;
+/// Standard error (unit-cube coordinates) below which a parameter counts as determined even when
+/// strongly correlated with another: the data pin both down despite the trade-off.
+const TIGHT: f64 = 0.02;
 
 /// The verdict on one parameter.
 #[derive(Clone, Debug, PartialEq)]
@@ -125,8 +128,8 @@ pub fn assess(id: &Identification, u: &[f64]) -> Result<Assessment> {
                 .filter(|&k| k != j && correlations[j * p + k].abs() > CORRELATED)
                 .max_by(|&a, &b| correlations[j * p + a].abs().total_cmp(&correlations[j * p + b].abs()));
             match partner {
-                Some(k) => Verdict::CorrelatedWith(k, correlations[j * p + k]),
-                None => Verdict::Determined,
+                Some(k) if se_u > TIGHT => Verdict::CorrelatedWith(k, correlations[j * p + k]),
+                _ => Verdict::Determined,
             }
         };
         let x = params[j].from_unit(u[j]);

@@ -166,6 +166,15 @@ pub fn optimize(
     })
 }
 
+/// The verdict in words, with the relative standard error of a determined parameter.
+fn describe_with_error(verdict: &Verdict, space: &czid_core::ParameterSpace, value: f64, se: Option<f64>) -> String {
+    match (verdict, se) {
+        (Verdict::Determined, Some(se)) if value != 0.0 => format!("determined (± {:.2} %)", 100.0 * se / value.abs()),
+        (Verdict::Determined, Some(se)) => format!("determined (± {se:.3e})"),
+        _ => verdict.describe(space),
+    }
+}
+
 /// Runs the identification described by `problem`, writing into `out`.
 pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> Result<IdentifyResult> {
     let id = problem.identification()?;
@@ -224,7 +233,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
                 initial: x0[i],
                 bounds: [p.lower, p.upper],
                 standard_error: assessment.standard_errors[i],
-                verdict: verdict.describe(id.space()),
+                verdict: describe_with_error(verdict, id.space(), x[i], assessment.standard_errors[i]),
             },
         );
     }
