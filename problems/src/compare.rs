@@ -54,16 +54,11 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
     let id = problem.identification()?;
     let budget = Budget { evaluations: opts.budget.unwrap_or(problem.file.optimizer.budget), target: None };
     let grid: Vec<usize> = (1..=50).map(|k| (budget.evaluations * k).div_ceil(50)).collect();
-    let spec = &problem.file.optimizer;
     let mut runs = Vec::new();
     for name in &opts.optimizers {
-        let settings = if *name == spec.kind {
-            toml::Value::Table(spec.settings.clone())
-        } else {
-            toml::Value::Table(Default::default())
-        };
+        let (kind, settings) = problem.file.optimizer_named(name);
         for seed in 1..=opts.seeds {
-            let run = optimize(&id, name, &settings, seed, &budget, None, &mut NoObserver)?;
+            let run = optimize(&id, &kind, &settings, seed, &budget, None, &mut NoObserver)?;
             let h = &run.result.history;
             let at = |n: usize| h.iter().take_while(|(e, _)| *e <= n).last().map_or(f64::NAN, |(_, v)| *v);
             let curve = grid.iter().map(|&n| at(n)).collect();

@@ -79,8 +79,7 @@ pub struct IdentifyResult {
     pub failed_evaluations: usize,
     /// Wall time of the optimisation (s).
     pub wall_seconds: f64,
-    /// Share of the wall time spent in forward simulations, summed over threads (may exceed 1 with
-    /// parallel evaluation).
+    /// Share of the run's CPU time (wall time × worker threads) spent in forward simulations.
     pub forward_share: f64,
     /// Warnings worth reading.
     pub warnings: Vec<String>,
@@ -179,13 +178,8 @@ fn describe_with_error(verdict: &Verdict, space: &czid_core::ParameterSpace, val
 pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> Result<IdentifyResult> {
     let id = problem.identification()?;
     let spec = &problem.file.optimizer;
-    let name = opts.optimizer.clone().unwrap_or_else(|| spec.kind.clone());
-    // Settings in the file belong to the file's optimizer; another one starts from its defaults.
-    let settings = if name == spec.kind {
-        toml::Value::Table(spec.settings.clone())
-    } else {
-        toml::Value::Table(Default::default())
-    };
+    let label = opts.optimizer.clone().unwrap_or_else(|| spec.kind.clone());
+    let (name, settings) = problem.file.optimizer_named(&label);
     let seed = opts.seed.unwrap_or(spec.seed);
     let budget = Budget { evaluations: opts.budget.unwrap_or(spec.budget), target: spec.target };
     if budget.evaluations == 0 {
@@ -243,7 +237,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     let res = IdentifyResult {
         problem: problem.path.display().to_string(),
         partial,
-        optimizer: name,
+        optimizer: if label == name { name } else { format!("{label} ({name})") },
         seed,
         budget: budget.evaluations,
         parameters,
@@ -254,7 +248,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         evaluations: result.evaluations,
         failed_evaluations: result.failures,
         wall_seconds: wall,
-        forward_share: forward_seconds / wall.max(1e-12),
+        forward_share: forward_seconds / (wall.max(1e-12) * rayon::current_num_threads() as f64),
         warnings,
     };
     let json = serde_json::to_string_pretty(&res).map_err(|e| CzError::config("result", e.to_string()))?;

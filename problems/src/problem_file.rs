@@ -34,6 +34,11 @@
 //! seed = 1
 //! budget = 20000              # objective evaluations
 //! [optimizer.settings]        # the optimizer's own settings
+//!
+//! [optimizers.polish]         # optional named alternatives, for `--optimizer polish` and
+//! type = "levenberg-marquardt" # `compare --optimizers miga,polish`
+//! [optimizers.polish.settings]
+//! fd_step = 1e-3
 //! ```
 
 use crate::data::{Experiment, ExperimentSpec};
@@ -128,6 +133,18 @@ fn default_seed() -> u64 {
     1
 }
 
+/// A named alternative optimizer: `[optimizers.<label>]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimizerChoice {
+    /// Registered name, as in `[optimizer]`.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// The optimizer's own settings.
+    #[serde(default)]
+    pub settings: toml::Table,
+}
+
 /// A whole problem file.
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -144,6 +161,24 @@ pub struct ProblemFile {
     pub objective: ObjectiveSpec,
     /// Optimizer choice.
     pub optimizer: OptimizerSpec,
+    /// Named alternatives, selected by label with `--optimizer` or in `compare`.
+    #[serde(default)]
+    pub optimizers: BTreeMap<String, OptimizerChoice>,
+}
+
+impl ProblemFile {
+    /// The registered name and settings that `label` stands for: a named alternative
+    /// (`[optimizers.<label>]`), the file's `[optimizer]` when `label` is its type, or else the
+    /// registered optimizer `label` with its default settings.
+    pub fn optimizer_named(&self, label: &str) -> (String, toml::Value) {
+        if let Some(choice) = self.optimizers.get(label) {
+            (choice.kind.clone(), toml::Value::Table(choice.settings.clone()))
+        } else if label == self.optimizer.kind {
+            (label.to_string(), toml::Value::Table(self.optimizer.settings.clone()))
+        } else {
+            (label.to_string(), toml::Value::Table(Default::default()))
+        }
+    }
 }
 
 /// A problem file read from disk, with its data loaded.
@@ -202,6 +237,13 @@ impl LoadedProblem {
         }
         if file.optimizer.budget == 0 {
             return Err(CzError::config(format!("{shown}, [optimizer]"), "budget must be at least 1 evaluation"));
+        }
+        // Optimizer names and settings are checked now, not after the data is loaded and a run set up.
+        let choices = std::iter::once(("[optimizer]".to_string(), &file.optimizer.kind, &file.optimizer.settings))
+            .chain(file.optimizers.iter().map(|(label, c)| (format!("[optimizers.{label}]"), &c.kind, &c.settings)));
+        for (table, kind, settings) in choices {
+            czid_optimizers::registry::optimizer_from_config(kind, &toml::Value::Table(settings.clone()))
+                .map_err(|e| CzError::config(format!("{shown}, {table}"), e.to_string()))?;
         }
         let base = path.parent().unwrap_or(Path::new("."));
         let mut experiments = Vec::new();
