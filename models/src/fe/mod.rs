@@ -13,7 +13,10 @@
 //! * `window`: the solution restricted to the nodes around a crack front, the linear regions
 //!   behind and ahead condensed exactly (used by [`path::run_with`]);
 //! * [`energy`]: external work, elastic and dissipated energy;
-//! * [`crack`]: debonded length, process zone and crack tip from the damage profile.
+//! * [`crack`]: debonded length, process zone and crack tip from the damage profile;
+//! * [`fibre`]: the fibre-section beam element (uniaxial materials with history through the depth);
+//! * [`nonlinear`]: problems with fibre layers under indirect displacement control (their own
+//!   assembly, Newton and path, energies including the materials' dissipation).
 //!
 //! Forward models ([`crate::dcb`], [`crate::enf`]) build an [`assembly::FeProblem`] from their
 //! configuration and call [`path::run_with`] (or [`path::run`]: nodal rule, every step recorded).
@@ -28,9 +31,11 @@ pub mod beam;
 pub mod corotational;
 pub mod crack;
 pub mod energy;
+pub mod fibre;
 pub mod interface;
 pub mod mesh;
 pub mod newton;
+pub mod nonlinear;
 pub mod path;
 pub mod segment;
 pub(crate) mod window;

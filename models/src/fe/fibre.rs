@@ -1,0 +1,206 @@
+//! Fibre-section beam element: a two-node beam whose axial force and bending moment come from
+//! uniaxial materials at fibres through the depth, with their history.
+//!
+//! Kinematics are those of [`super::beam`]: linear `u` and `θ` along the element, so the axial
+//! strain `ε` and the curvature `κ = θ'` are constant and one section at the element's middle
+//! integrates it exactly. A fibre at height `z` above the layer's centroid has the strain
+//! `ε − z κ − ε₀` (plane sections; `ε₀` an initial, stress-free strain such as shrinkage). The
+//! section forces are `N = Σ σ A` and `M = −Σ σ A z` (work-conjugate to `ε` and `κ`), their
+//! tangent the fibres' `Σ E_t A [1, −z; −z, z²]`. Transverse shear is not part of the fibre
+//! section: the layer's linear shear stiffness `κGA` (its [`super::mesh::Section`] with a zero
+//! axial modulus) carries it.
+//!
+//! Energies per fibre: the recoverable part is the material's ([`FibreMaterial::stored_energy`]),
+//! the work is integrated step by step along the straight strain path by Simpson's rule with the
+//! material itself evaluated at the middle of the step ([`FibreMaterial::step_work`]), so that work
+//! minus recoverable energy is the energy the material dissipated (cracking, crushing, yielding).
+
+use serde::{Deserialize, Serialize};
+
+use crate::materials::{Concrete, Steel, UniaxialMaterial, UniaxialResponse, UniaxialState};
+
+/// The material of a fibre.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum FibreMaterial {
+    /// Concrete (secant unloading to the origin: its recoverable energy is `½ σ ε`).
+    Concrete(Concrete),
+    /// Steel (elastic unloading: its recoverable energy is `σ²/(2 E_s)`).
+    Steel(Steel),
+    /// Concrete that does not crack (linear elastic in tension, the concrete's own curve in
+    /// compression): concrete between discrete cracks, whose tension the bond of the bars limits.
+    UncrackedConcrete(Concrete),
+    /// Concrete of a cracked segment of length `s` lumped into a crack element of length `l`: no
+    /// tension (the crack is open), the concrete's own curve in compression at the element strain
+    /// times `ratio = l/s` (recoverable energy `½ σ ε`, as a secant material).
+    CrackedConcrete {
+        /// The concrete.
+        concrete: Concrete,
+        /// Element length over segment length.
+        ratio: f64,
+    },
+    /// Steel of a cracked segment of length `s` lumped into a crack element of length `l` (its
+    /// elongation at a crack collects over the crack spacing): the steel sees the element strain
+    /// times `ratio = l/s` (recoverable energy `σ²/(2 E_s ratio)` per unit volume of the element).
+    CrackSteel {
+        /// The bars' steel.
+        steel: Steel,
+        /// Element length over transfer length.
+        ratio: f64,
+    },
+}
+
+impl FibreMaterial {
+    /// Stress, tangent and trial state at the mechanical `strain` from the committed `state`.
+    #[inline]
+    pub fn respond(&self, strain: f64, state: &UniaxialState) -> UniaxialResponse {
+        match self {
+            FibreMaterial::Concrete(c) => c.respond(strain, state),
+            FibreMaterial::Steel(s) => s.respond(strain, state),
+            FibreMaterial::UncrackedConcrete(c) => {
+                if strain < 0.0 {
+                    c.respond(strain, state)
+                } else {
+                    UniaxialResponse { stress: c.elastic_modulus * strain, tangent: c.elastic_modulus, state: *state }
+                }
+            }
+            FibreMaterial::CrackedConcrete { concrete, ratio } => {
+                if strain < 0.0 {
+                    let mut r = concrete.respond(strain * ratio, state);
+                    r.tangent *= ratio;
+                    r
+                } else {
+                    UniaxialResponse { stress: 0.0, tangent: 0.0, state: *state }
+                }
+            }
+            FibreMaterial::CrackSteel { steel, ratio } => {
+                let mut r = steel.respond(strain * ratio, state);
+                r.tangent *= ratio;
+                r
+            }
+        }
+    }
+
+    /// Recoverable energy per unit volume at `strain` with stress `stress` (MPa = N·mm/mm³).
+    #[inline]
+    pub fn stored_energy(&self, strain: f64, stress: f64) -> f64 {
+        match self {
+            FibreMaterial::Concrete(_)
+            | FibreMaterial::UncrackedConcrete(_)
+            | FibreMaterial::CrackedConcrete { .. } => 0.5 * stress * strain,
+            FibreMaterial::Steel(s) => 0.5 * stress * stress / s.elastic_modulus,
+            FibreMaterial::CrackSteel { steel, ratio } => 0.5 * stress * stress / (steel.elastic_modulus * ratio),
+        }
+    }
+
+    /// Work per unit volume along the straight strain path `e0 → e1` from the committed `state`,
+    /// stresses `s0` and `s1` at the ends (Simpson's rule, middle stress from the material).
+    #[inline]
+    pub fn step_work(&self, state: &UniaxialState, (e0, s0): (f64, f64), (e1, s1): (f64, f64)) -> f64 {
+        if e1 == e0 {
+            return 0.0;
+        }
+        let sm = self.respond(0.5 * (e0 + e1), state).stress;
+        (e1 - e0) / 6.0 * (s0 + 4.0 * sm + s1)
+    }
+}
+
+/// One fibre of a section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fibre {
+    /// Height above the layer's centroid (mm).
+    pub z: f64,
+    /// Area (mm²); negative to take out the concrete a bar displaces.
+    pub area: f64,
+    /// Index into [`FibreSection::materials`].
+    pub material: usize,
+    /// Stress-free initial strain (e.g. free shrinkage of concrete).
+    pub initial_strain: f64,
+}
+
+/// A cross-section as fibres.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FibreSection {
+    /// The materials the fibres refer to.
+    pub materials: Vec<FibreMaterial>,
+    /// The fibres.
+    pub fibres: Vec<Fibre>,
+}
+
+/// Section response at generalised strains `[ε, κ]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SectionResponse {
+    /// `[N, M]` (N, N·mm).
+    pub force: [f64; 2],
+    /// `∂[N, M]/∂[ε, κ]`.
+    pub tangent: [[f64; 2]; 2],
+}
+
+impl FibreSection {
+    /// Mechanical strain of fibre `f` at generalised strains `e = [ε, κ]`.
+    #[inline]
+    pub fn strain(&self, f: &Fibre, e: [f64; 2]) -> f64 {
+        e[0] - f.z * e[1] - f.initial_strain
+    }
+
+    /// Section forces and tangent at `e` from the committed `states` (one per fibre); the trial
+    /// states and stresses go to `trial` and `stress`. With `secant`, each fibre contributes its
+    /// secant stiffness `σ/ε` (non-negative for these materials under monotonic loading) instead
+    /// of its tangent: an iteration matrix that cannot cycle between loading and unloading.
+    pub fn respond(
+        &self,
+        e: [f64; 2],
+        states: &[UniaxialState],
+        trial: &mut [UniaxialState],
+        stress: &mut [f64],
+        secant: bool,
+    ) -> SectionResponse {
+        let mut r = SectionResponse::default();
+        for (k, f) in self.fibres.iter().enumerate() {
+            let res = self.materials[f.material].respond(self.strain(f, e), &states[k]);
+            // (the iteration stiffness below)
+            trial[k] = res.state;
+            stress[k] = res.stress;
+            let mech = self.strain(f, e);
+            let stiffness = if secant && mech.abs() > 1e-12 { (res.stress / mech).max(0.0) } else { res.tangent };
+            let (fa, ka) = (res.stress * f.area, stiffness * f.area);
+            r.force[0] += fa;
+            r.force[1] -= fa * f.z;
+            r.tangent[0][0] += ka;
+            r.tangent[0][1] -= ka * f.z;
+            r.tangent[1][1] += ka * f.z * f.z;
+        }
+        r.tangent[1][0] = r.tangent[0][1];
+        r
+    }
+}
+
+/// Generalised strains `[ε, κ]` of an element of length `l` with nodal `[u1, w1, θ1, u2, w2, θ2]`.
+#[inline]
+pub fn strains(l: f64, q: &[f64; 6]) -> [f64; 2] {
+    [(q[3] - q[0]) / l, (q[5] - q[2]) / l]
+}
+
+/// Nodal forces `Bᵀ [N, M] l` and tangent `Bᵀ D B l` of an element of length `l` from its section
+/// response (only the `u` and `θ` entries are non-zero).
+pub fn element(l: f64, s: &SectionResponse) -> ([f64; 6], [[f64; 6]; 6]) {
+    // B: ε = (u2 − u1)/l, κ = (θ2 − θ1)/l.
+    let b: [[f64; 6]; 2] = [[-1.0 / l, 0.0, 0.0, 1.0 / l, 0.0, 0.0], [0.0, 0.0, -1.0 / l, 0.0, 0.0, 1.0 / l]];
+    let mut f = [0.0; 6];
+    let mut k = [[0.0; 6]; 6];
+    for i in 0..6 {
+        f[i] = (b[0][i] * s.force[0] + b[1][i] * s.force[1]) * l;
+        if b[0][i] == 0.0 && b[1][i] == 0.0 {
+            continue;
+        }
+        for j in 0..6 {
+            let mut v = 0.0;
+            for r in 0..2 {
+                for c in 0..2 {
+                    v += b[r][i] * s.tangent[r][c] * b[c][j];
+                }
+            }
+            k[i][j] = v * l;
+        }
+    }
+    (f, k)
+}

@@ -1,0 +1,779 @@
+//! Problems with materially nonlinear beams: fibre-section layers ([`super::fibre`]) beside the
+//! linear Timoshenko layers and the cohesive interface, loaded by a force pattern whose magnitude
+//! follows from an indirect displacement control.
+//!
+//! **Why indirect control.** A structure whose cohesive interface fails while its beams yield
+//! (an FRP-plated RC beam losing its plate) can lose load while its load point moves back
+//! (snap-back), and the dissipation constraint of [`super::path`] presumes elastic-damage
+//! materials (its released energy `½(λ₀ Δc − Δλ c₀)` counts elastic unloading of a yielded bar as
+//! released). Here the load is `P e` (`e` a fixed pattern) and the path is followed in a
+//! quantity chosen to grow monotonically through the failure, a linear combination `c = a·q` of
+//! the unknowns (for a plated beam: the elongation of the concrete soffit, which every crack
+//! opening and every debonded length increases). Each step solves the bordered system
+//! `f_int(q) = P e`, `a·q = c` by Newton's method (Crisfield's indirect displacement control):
+//! `K x₁ = −r`, `K x₂ = e`, `ΔP = (c − a·q − a·x₁)/(a·x₂)`, `Δq = x₁ + ΔP x₂`.
+//!
+//! **Interface in series with a compliance.** Each cohesive point may carry a linear compliance
+//! `C = diag(c_n, c_t)` (mm/MPa) in series with the law (an adhesive layer): the law sees the gap
+//! `g_l` solving `g_l + C T(g_l) = g` (a local Newton solve per point), and the point's stiffness
+//! is `D (I + C D)⁻¹`. With `C = 0` this code path is not entered at all.
+//!
+//! **Energy.** External work `∫ P d(e·q)` (trapezoidal rule over steps); elastic energy: the
+//! linear layers' exact strain energy, the fibres' recoverable energy and the interface's
+//! (law plus compliance, `½ T·C T`); dissipated energy of the interface (work along each point's gap
+//! path by [`super::energy::path_work`] minus its recoverable energy) and of the fibres (work by
+//! [`FibreMaterial::step_work`] minus recoverable energy), each integrated point by point and
+//! independently of the external work, so `W = U + D_interface + D_material` is a genuine check.
+//!
+//! **Initial strains** (shrinkage): if a fibre has one, the unloaded structure is first brought to
+//! equilibrium at `P = 0`; energies are counted from that state.
+//!
+//! Small rotations and the nodal interface rule (each point with its tributary area).
+
+use czid_core::{CohesiveLaw, CzError, Gap, LawEval, LawState, Tangent, Traction};
+
+use super::assembly::{loading_tangent, strengths, Spring};
+use super::banded::BandMatrix;
+use super::beam;
+use super::crack::{self, CrackMeasures};
+use super::energy::path_work;
+use super::fibre::{self, FibreMaterial, FibreSection};
+use super::interface::{self, InterfacePoint, PointKind};
+use super::mesh::{Mesh, NONE};
+use super::newton::NewtonSettings;
+use crate::materials::UniaxialState;
+
+/// A mesh layer whose axial force and moment come from a fibre section.
+#[derive(Clone, Debug)]
+pub struct FibreLayer {
+    /// Index of the layer in the mesh. Its [`super::mesh::Section`] gives the shear stiffness only
+    /// and must have a zero axial modulus `e`.
+    pub layer: usize,
+    /// The sections the elements use.
+    pub sections: Vec<FibreSection>,
+    /// Section of each element of the layer (index into `sections`), in order along the layer.
+    pub element_section: Vec<usize>,
+}
+
+/// The discrete problem.
+#[derive(Clone, Debug)]
+pub struct NonlinearProblem {
+    /// Nodes, layers, unknowns.
+    pub mesh: Mesh,
+    /// Cohesive interface points (nodal rule; small rotations).
+    pub points: Vec<InterfacePoint>,
+    /// Unknowns held at zero.
+    pub fixed: Vec<usize>,
+    /// Fibre-section layers.
+    pub fibre_layers: Vec<FibreLayer>,
+    /// Load pattern: the force on unknown `i` is `P × coefficient`. Its work-conjugate
+    /// displacement is `Σ coefficient q_i`.
+    pub load: Vec<(usize, f64)>,
+    /// Control: `c = Σ coefficient q_i`, increased monotonically along the path.
+    pub control: Vec<(usize, f64)>,
+    /// Compliance in series with the law, `[normal, tangential]` (mm/MPa).
+    pub compliance: [f64; 2],
+    /// Linear springs (restraints); their energy is part of the elastic energy.
+    pub springs: Vec<Spring>,
+}
+
+/// How far and how finely to follow the path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ControlPath {
+    /// Spacing of the control values at which states are recorded (all hit exactly).
+    pub spacing: f64,
+    /// Largest control value.
+    pub max_control: f64,
+    /// Smallest step, as a fraction of the spacing, before the run gives up.
+    pub min_step_fraction: f64,
+    /// Damage at or above which a point counts as debonded.
+    pub damage_threshold: f64,
+    /// Newton settings.
+    pub newton: NewtonSettings,
+}
+
+/// One recorded state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NonlinearRow {
+    /// Control value `c`.
+    pub control: f64,
+    /// Load factor `P`.
+    pub load: f64,
+    /// Work-conjugate displacement of the load pattern.
+    pub displacement: f64,
+    /// Work of the load (N·mm).
+    pub external_work: f64,
+    /// Recoverable energy of beams, fibres and interface (N·mm).
+    pub elastic_energy: f64,
+    /// Energy dissipated by the interface (N·mm).
+    pub interface_dissipation: f64,
+    /// Energy dissipated by the fibre materials (N·mm).
+    pub material_dissipation: f64,
+    /// Debonded length and process zone along the interface points.
+    pub crack: CrackMeasures,
+}
+
+/// A converged state shown to the caller's observer.
+pub struct Snapshot<'a> {
+    /// The recorded row.
+    pub row: &'a NonlinearRow,
+    /// Unknowns.
+    pub q: &'a [f64],
+    /// Committed law states of the interface points.
+    pub point_states: &'a [LawState],
+    /// Gaps of the interface points (total, compliance included).
+    pub gaps: &'a [Gap],
+    /// Tractions of the interface points.
+    pub tractions: &'a [Traction],
+}
+
+/// Statistics of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NonlinearStats {
+    /// Converged steps.
+    pub steps: usize,
+    /// Assemblies.
+    pub assemblies: usize,
+    /// Factorisations.
+    pub factorizations: usize,
+    /// Steps cut after a failure.
+    pub cuts: usize,
+}
+
+/// A failed run: the error and the rows recorded before it.
+#[derive(Clone, Debug)]
+pub struct NonlinearFailure {
+    /// What went wrong.
+    pub error: CzError,
+    /// Rows recorded before.
+    pub rows: Vec<NonlinearRow>,
+}
+
+struct Element {
+    layer: usize,
+    dofs: [usize; 6],
+    len: f64,
+}
+
+struct FibreElement {
+    fl: usize,
+    section: usize,
+    dofs: [usize; 6],
+    len: f64,
+    /// First fibre state of this element in the flat state arrays.
+    first: usize,
+}
+
+/// Committed or trial state of everything with history.
+#[derive(Clone)]
+struct History {
+    points: Vec<LawState>,
+    law_gaps: Vec<Gap>,
+    tractions: Vec<Traction>,
+    gaps: Vec<Gap>,
+    fibres: Vec<UniaxialState>,
+    strains: Vec<f64>,
+    stresses: Vec<f64>,
+}
+
+struct Solver<'a> {
+    p: &'a NonlinearProblem,
+    law: &'a dyn CohesiveLaw,
+    elements: Vec<Element>,
+    fibre_elements: Vec<FibreElement>,
+    linear: BandMatrix,
+    k: BandMatrix,
+    f: Vec<f64>,
+    fixed_mask: Vec<bool>,
+    strength: [f64; 2],
+    /// Trial results of the last assembly.
+    trial: History,
+    iteration_tangents: Vec<Tangent>,
+    load: Vec<f64>,
+    settings: NewtonSettings,
+    stats: NonlinearStats,
+    with_compliance: bool,
+    /// Secant iterations after a correction that increased the residual.
+    secant_iterations: usize,
+}
+
+#[inline]
+fn get(q: &[f64], d: usize) -> f64 {
+    if d == NONE {
+        0.0
+    } else {
+        q[d]
+    }
+}
+
+fn scatter(k: &mut BandMatrix, dofs: &[usize; 6], ke: &[[f64; 6]; 6]) {
+    for (a, &da) in dofs.iter().enumerate() {
+        if da == NONE {
+            continue;
+        }
+        for (b, &db) in dofs.iter().enumerate() {
+            if db != NONE && ke[a][b] != 0.0 {
+                k.add(da, db, ke[a][b]);
+            }
+        }
+    }
+}
+
+/// Checks the problem's consistency.
+fn check(p: &NonlinearProblem) -> Result<(), CzError> {
+    let n = p.mesh.n_dofs();
+    for fl in &p.fibre_layers {
+        let Some(layer) = p.mesh.layers.get(fl.layer) else {
+            return Err(CzError::Simulation(format!("fibre layer {} is not a layer of the mesh", fl.layer)));
+        };
+        if layer.section.e != 0.0 {
+            return Err(CzError::Simulation(format!(
+                "fibre layer {}: its linear section must have a zero axial modulus (the fibres carry N and M)",
+                fl.layer
+            )));
+        }
+        if !layer.axial {
+            return Err(CzError::Simulation(format!("fibre layer {} needs axial unknowns", fl.layer)));
+        }
+        if fl.element_section.len() != layer.last - layer.first
+            || fl.element_section.iter().any(|&k| k >= fl.sections.len())
+        {
+            return Err(CzError::Simulation(format!(
+                "fibre layer {}: needs one valid section index per element",
+                fl.layer
+            )));
+        }
+        if fl.sections.iter().any(|sec| sec.fibres.iter().any(|f| f.material >= sec.materials.len())) {
+            return Err(CzError::Simulation(format!("fibre layer {}: a fibre names a missing material", fl.layer)));
+        }
+    }
+    let bad = |d: &usize| *d >= n;
+    if p.springs.iter().any(|sp| bad(&sp.i) || (sp.j != NONE && bad(&sp.j))) {
+        return Err(CzError::Simulation("a spring names an unknown out of range".into()));
+    }
+    if p.fixed.iter().any(bad) || p.load.iter().any(|(d, _)| bad(d)) || p.control.iter().any(|(d, _)| bad(d)) {
+        return Err(CzError::Simulation("an unknown of the problem is out of range".into()));
+    }
+    if p.load.is_empty() || p.control.is_empty() {
+        return Err(CzError::Simulation("the problem needs a load pattern and a control".into()));
+    }
+    if p.points.iter().any(|pt| pt.kind != PointKind::Cohesive || pt.lower.is_none()) {
+        return Err(CzError::Simulation("nonlinear problems take cohesive points between two layers only".into()));
+    }
+    if !(p.compliance.iter().all(|c| c.is_finite() && *c >= 0.0)) {
+        return Err(CzError::Simulation("the interface compliance must be finite and non-negative".into()));
+    }
+    Ok(())
+}
+
+impl<'a> Solver<'a> {
+    fn new(p: &'a NonlinearProblem, law: &'a dyn CohesiveLaw, settings: NewtonSettings) -> Self {
+        let mesh = &p.mesh;
+        let mut elements = Vec::new();
+        for (k, layer) in mesh.layers.iter().enumerate() {
+            for i in layer.first..layer.last {
+                let (a, b) = (mesh.dofs(k, i), mesh.dofs(k, i + 1));
+                elements.push(Element {
+                    layer: k,
+                    dofs: [a[0], a[1], a[2], b[0], b[1], b[2]],
+                    len: mesh.x[i + 1] - mesh.x[i],
+                });
+            }
+        }
+        let n = mesh.n_dofs();
+        let mut linear = BandMatrix::zeros(n, mesh.bandwidth());
+        for e in &elements {
+            scatter(&mut linear, &e.dofs, &beam::stiffness(&mesh.layers[e.layer].section, e.len));
+        }
+        for sp in &p.springs {
+            linear.add(sp.i, sp.i, sp.k * sp.ci * sp.ci);
+            if sp.j != NONE {
+                linear.add(sp.j, sp.j, sp.k);
+                linear.add(sp.i, sp.j, -sp.k * sp.ci);
+                linear.add(sp.j, sp.i, -sp.k * sp.ci);
+            }
+        }
+        let mut fibre_elements = Vec::new();
+        let mut nfib = 0;
+        for (ifl, fl) in p.fibre_layers.iter().enumerate() {
+            let layer = &mesh.layers[fl.layer];
+            for i in layer.first..layer.last {
+                let (a, b) = (mesh.dofs(fl.layer, i), mesh.dofs(fl.layer, i + 1));
+                let section = fl.element_section[i - layer.first];
+                fibre_elements.push(FibreElement {
+                    fl: ifl,
+                    section,
+                    dofs: [a[0], a[1], a[2], b[0], b[1], b[2]],
+                    len: mesh.x[i + 1] - mesh.x[i],
+                    first: nfib,
+                });
+                nfib += fl.sections[section].fibres.len();
+            }
+        }
+        let np = p.points.len();
+        let init = law.initial_state();
+        let trial = History {
+            points: vec![init; np],
+            law_gaps: vec![Gap::zeros(); np],
+            tractions: vec![Traction::zeros(); np],
+            gaps: vec![Gap::zeros(); np],
+            fibres: vec![UniaxialState::default(); nfib],
+            strains: vec![0.0; nfib],
+            stresses: vec![0.0; nfib],
+        };
+        let mut fixed_mask = vec![false; n];
+        for &d in &p.fixed {
+            fixed_mask[d] = true;
+        }
+        let mut load = vec![0.0; n];
+        for &(d, c) in &p.load {
+            load[d] += c;
+        }
+        Solver {
+            p,
+            law,
+            elements,
+            fibre_elements,
+            k: BandMatrix::zeros(n, mesh.bandwidth()),
+            linear,
+            f: vec![0.0; n],
+            fixed_mask,
+            strength: strengths(law),
+            trial,
+            iteration_tangents: vec![Tangent::zeros(); np],
+            load,
+            settings,
+            stats: NonlinearStats::default(),
+            with_compliance: p.compliance != [0.0, 0.0],
+            secant_iterations: 4,
+        }
+    }
+
+    /// Internal forces and tangent at `q` from the committed history `c`; `false` if something
+    /// is not finite (or a series-compliance solve failed).
+    fn assemble(&mut self, c: &History, q: &[f64], secant: bool) -> bool {
+        self.stats.assemblies += 1;
+        let p = self.p;
+        self.k.copy_from(&self.linear);
+        self.linear.mul_vec(q, &mut self.f);
+        let mut ok = true;
+        for fe in &self.fibre_elements {
+            let sec = &p.fibre_layers[fe.fl].sections[fe.section];
+            let mut qe = [0.0; 6];
+            for (v, &d) in qe.iter_mut().zip(&fe.dofs) {
+                *v = get(q, d);
+            }
+            let e = fibre::strains(fe.len, &qe);
+            let nf = sec.fibres.len();
+            let range = fe.first..fe.first + nf;
+            let r = sec.respond(
+                e,
+                &c.fibres[range.clone()],
+                &mut self.trial.fibres[range.clone()],
+                &mut self.trial.stresses[range.clone()],
+                secant,
+            );
+            for (k, fib) in sec.fibres.iter().enumerate() {
+                self.trial.strains[fe.first + k] = sec.strain(fib, e);
+            }
+            let (fv, kv) = fibre::element(fe.len, &r);
+            for (a, &da) in fe.dofs.iter().enumerate() {
+                if da != NONE {
+                    self.f[da] += fv[a];
+                }
+            }
+            scatter(&mut self.k, &fe.dofs, &kv);
+            ok &= fv.iter().all(|v| v.is_finite());
+        }
+        let mut hess = [[[0.0; 8]; 8]; 2];
+        for (ip, pt) in p.points.iter().enumerate() {
+            let kin = interface::kinematics(&p.mesh, pt, q, false, &mut hess);
+            let gap = Gap::new(kin.gap[0], kin.gap[1]);
+            let state = &c.points[ip];
+            let (ev, d, gl) = if self.with_compliance {
+                match self.series(&gap, state, c.law_gaps[ip], secant) {
+                    Some(v) => v,
+                    None => return false,
+                }
+            } else {
+                let ev = self.law.evaluate(&gap, state);
+                let d = if secant {
+                    secant_stiffness(&gap, &ev)
+                } else {
+                    loading_tangent(self.law, &self.strength, &gap, state, &ev)
+                };
+                (ev, d, gap)
+            };
+            let t = ev.traction;
+            if !(t[0].is_finite() && t[1].is_finite() && d.iter().all(|v| v.is_finite())) {
+                ok = false;
+            }
+            self.trial.points[ip] = ev.state;
+            self.trial.tractions[ip] = t;
+            self.trial.gaps[ip] = gap;
+            self.trial.law_gaps[ip] = gl;
+            self.iteration_tangents[ip] = d;
+            let w = pt.area * pt.factor;
+            let g = &kin.grad;
+            for a in 0..8 {
+                let da = kin.dofs[a];
+                if da == NONE || (g[0][a] == 0.0 && g[1][a] == 0.0) {
+                    continue;
+                }
+                self.f[da] += w * (g[0][a] * t[0] + g[1][a] * t[1]);
+                let ra0 = g[0][a] * d[(0, 0)] + g[1][a] * d[(1, 0)];
+                let ra1 = g[0][a] * d[(0, 1)] + g[1][a] * d[(1, 1)];
+                for b in 0..8 {
+                    let db = kin.dofs[b];
+                    if db == NONE {
+                        continue;
+                    }
+                    let v = ra0 * g[0][b] + ra1 * g[1][b];
+                    if v != 0.0 {
+                        self.k.add(da, db, w * v);
+                    }
+                }
+            }
+        }
+        ok
+    }
+
+    /// The law behind the series compliance: solves `g_l + C T(g_l) = g` from the guess `g0`;
+    /// returns the law's evaluation at `g_l`, the point's iteration stiffness `D (I + C D)⁻¹` and
+    /// `g_l`.
+    fn series(&self, gap: &Gap, state: &LawState, g0: Gap, secant: bool) -> Option<(LawEval, Tangent, Gap)> {
+        let c = self.p.compliance;
+        let cm = Tangent::new(c[0], 0.0, 0.0, c[1]);
+        let id = Tangent::identity();
+        let mut gl = g0;
+        let scale = gap.norm().max(1e-12);
+        for _ in 0..60 {
+            let ev = self.law.evaluate(&gl, state);
+            let r = gl + cm * ev.traction - gap;
+            if r.norm() <= 1e-13 * scale {
+                let d = if secant {
+                    secant_stiffness(&gl, &ev)
+                } else {
+                    loading_tangent(self.law, &self.strength, &gl, state, &ev)
+                };
+                let eff = d * (id + cm * d).try_inverse()?;
+                return Some((ev, eff, gl));
+            }
+            let j = id + cm * ev.tangent;
+            let step = j.try_inverse()? * r;
+            gl -= step;
+        }
+        None
+    }
+
+    fn scale(&self) -> f64 {
+        self.f.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300)
+    }
+
+    /// Newton's method at control `c_target` (`None`: at zero load, no control) from the predictor
+    /// `q`, `load`; returns the iterations on success.
+    fn solve(&mut self, c: &History, q: &mut [f64], load: &mut f64, c_target: Option<f64>) -> Option<usize> {
+        let n = q.len();
+        let mut r = vec![0.0; n];
+        let mut b = vec![0.0; n];
+        let mut dq = vec![0.0; n];
+        let mut dload = 0.0;
+        // Safeguard against branch cycling (a cracking fibre or a softening interface point
+        // flipping between loading and unloading from one iteration to the next): a correction
+        // that increased the residual is halved, and the next iterations use secant stiffnesses (a
+        // fixed-point iteration that settles the active set) before Newton resumes.
+        let mut r_prev = f64::INFINITY;
+        let mut alpha = 1.0f64;
+        let mut secant_left = 0usize;
+        let mut it = 0usize;
+        let max_it = self.settings.max_iterations;
+        while it <= max_it {
+            if !self.assemble(c, q, secant_left > 0) {
+                return None;
+            }
+            let tol = self.settings.tolerance * self.scale();
+            let mut rmax = 0.0f64;
+            for i in 0..n {
+                let v = if self.fixed_mask[i] { 0.0 } else { self.f[i] - *load * self.load[i] };
+                r[i] = -v;
+                rmax = rmax.max(v.abs());
+            }
+            if !rmax.is_finite() {
+                return None;
+            }
+            let ctl: f64 = self.p.control.iter().map(|&(d, a)| a * q[d]).sum();
+            let cres = c_target.map_or(0.0, |t| t - ctl);
+            if rmax <= tol && cres.abs() <= 1e-12 * ctl.abs().max(1e-9) {
+                return Some(it);
+            }
+            if rmax > r_prev && alpha > 0.3 {
+                alpha *= 0.5;
+                for (qi, di) in q.iter_mut().zip(&dq) {
+                    *qi -= alpha * di;
+                }
+                *load -= alpha * dload;
+                secant_left = self.secant_iterations;
+                it += 1;
+                continue;
+            }
+            if it >= max_it {
+                break;
+            }
+            it += 1;
+            secant_left = secant_left.saturating_sub(1);
+            r_prev = rmax;
+            alpha = 1.0;
+            for &d in &self.p.fixed {
+                self.k.set_identity_row_col(d);
+            }
+            self.stats.factorizations += 1;
+            self.k.factorize().ok()?;
+            if c_target.is_some() {
+                for i in 0..n {
+                    b[i] = if self.fixed_mask[i] { 0.0 } else { self.load[i] };
+                }
+                self.k.solve2_in_place(&mut r, &mut b);
+                let a1: f64 = self.p.control.iter().map(|&(d, a)| a * r[d]).sum();
+                let a2: f64 = self.p.control.iter().map(|&(d, a)| a * b[d]).sum();
+                if a2 == 0.0 || !a2.is_finite() {
+                    return None;
+                }
+                dload = (cres - a1) / a2;
+                for i in 0..n {
+                    dq[i] = r[i] + dload * b[i];
+                    q[i] += dq[i];
+                }
+                *load += dload;
+            } else {
+                self.k.solve_in_place(&mut r);
+                dload = 0.0;
+                dq.copy_from_slice(&r);
+                for (qi, ri) in q.iter_mut().zip(&r) {
+                    *qi += ri;
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Secant stiffness `diag(T_n/g_n, T_t/g_t)` of a damage law, non-negative (the tangent's diagonal
+/// at a zero gap component).
+fn secant_stiffness(gap: &Gap, ev: &LawEval) -> Tangent {
+    let mut d = Tangent::zeros();
+    for i in 0..2 {
+        let v = if gap[i].abs() > 1e-14 { ev.traction[i] / gap[i] } else { ev.tangent[(i, i)] };
+        d[(i, i)] = v.max(0.0);
+    }
+    d
+}
+
+/// Running energy totals.
+#[derive(Clone, Copy, Default)]
+struct Totals {
+    external: f64,
+    interface_work: f64,
+    material_work: f64,
+}
+
+/// Follows the path of `p` with `law` under the indirect control `path`. `observe` sees every
+/// recorded state and returns `true` to end the run there (e.g. once the interface has failed).
+pub fn run(
+    p: &NonlinearProblem,
+    law: &dyn CohesiveLaw,
+    path: &ControlPath,
+    observe: &mut dyn FnMut(&Snapshot) -> bool,
+) -> Result<(Vec<NonlinearRow>, NonlinearStats), NonlinearFailure> {
+    let fail = |rows: Vec<NonlinearRow>, msg: String| NonlinearFailure { error: CzError::Simulation(msg), rows };
+    if let Err(e) = check(p) {
+        return Err(NonlinearFailure { error: e, rows: Vec::new() });
+    }
+    if !(path.spacing > 0.0 && path.max_control > 0.0 && path.spacing.is_finite() && path.max_control.is_finite()) {
+        return Err(fail(Vec::new(), "the control path needs a positive spacing and end".into()));
+    }
+    let mut s = Solver::new(p, law, path.newton);
+    let n = p.mesh.n_dofs();
+    let mut committed = s.trial.clone();
+    let mut q = vec![0.0; n];
+    let mut load = 0.0;
+    let mut rows = Vec::new();
+    let xs: Vec<f64> = p.points.iter().map(|pt| p.mesh.x[pt.node]).collect();
+    let mut dmg = vec![0.0; p.points.len()];
+    let mut scratch = vec![0.0; p.points.len()];
+    let displacement = |q: &[f64]| -> f64 { p.load.iter().map(|&(d, a)| a * q[d]).sum() };
+    let control = |q: &[f64]| -> f64 { p.control.iter().map(|&(d, a)| a * q[d]).sum() };
+
+    // Energies at a committed state: (elastic, interface stored, fibre stored).
+    let stored = |s: &Solver, h: &History, q: &[f64]| -> (f64, f64, f64) {
+        let mut lin = 0.0;
+        for e in &s.elements {
+            let mut qe = [0.0; 6];
+            for (v, &d) in qe.iter_mut().zip(&e.dofs) {
+                *v = get(q, d);
+            }
+            lin += beam::energy(&p.mesh.layers[e.layer].section, e.len, &qe);
+        }
+        for sp in &p.springs {
+            let d = sp.ci * q[sp.i] - get(q, sp.j);
+            lin += 0.5 * sp.k * d * d;
+        }
+        let mut fib = 0.0;
+        for fe in &s.fibre_elements {
+            let sec = &p.fibre_layers[fe.fl].sections[fe.section];
+            for (k, f) in sec.fibres.iter().enumerate() {
+                let i = fe.first + k;
+                fib += f.area * fe.len * sec.materials[f.material].stored_energy(h.strains[i], h.stresses[i]);
+            }
+        }
+        let c = p.compliance;
+        let mut int = 0.0;
+        for (ip, pt) in p.points.iter().enumerate() {
+            let t = h.tractions[ip];
+            let adhesive = 0.5 * (c[0] * t[0] * t[0] + c[1] * t[1] * t[1]);
+            int += pt.area * pt.factor * (law.stored_energy(&h.law_gaps[ip], &h.points[ip]) + adhesive);
+        }
+        (lin + fib + int, int, fib)
+    };
+
+    // Initial strains: equilibrium at zero load first.
+    let initial = p
+        .fibre_layers
+        .iter()
+        .any(|fl| fl.sections.iter().any(|sec| sec.fibres.iter().any(|f| f.initial_strain != 0.0)));
+    if initial {
+        if s.solve(&committed, &mut q, &mut load, None).is_none() {
+            return Err(fail(rows, "no equilibrium under the initial strains".into()));
+        }
+        committed = s.trial.clone();
+    }
+    let (u0, i0, f0) = stored(&s, &committed, &q);
+    // Work done before the path (by initial strains) is outside the balance: start from here.
+    let mut totals = Totals { external: 0.0, interface_work: i0, material_work: f0 };
+    let elastic0 = u0;
+    let c0 = control(&q);
+    let mut record = |s: &Solver,
+                      h: &History,
+                      q: &[f64],
+                      load: f64,
+                      totals: &Totals,
+                      rows: &mut Vec<NonlinearRow>,
+                      observe: &mut dyn FnMut(&Snapshot) -> bool|
+     -> bool {
+        let (u, int, fib) = stored(s, h, q);
+        for (d, st) in dmg.iter_mut().zip(&h.points) {
+            *d = st.damage;
+        }
+        let crack = crack::measure(&xs, &dmg, path.damage_threshold, xs.first().copied().unwrap_or(0.0), &mut scratch);
+        let row = NonlinearRow {
+            control: control(q) - c0,
+            load,
+            displacement: displacement(q),
+            external_work: totals.external,
+            elastic_energy: u - elastic0,
+            interface_dissipation: totals.interface_work - int,
+            material_dissipation: totals.material_work - fib,
+            crack,
+        };
+        rows.push(row);
+        let snap = Snapshot { row: &row, q, point_states: &h.points, gaps: &h.gaps, tractions: &h.tractions };
+        observe(&snap)
+    };
+    if record(&s, &committed, &q, load, &totals, &mut rows, observe) {
+        return Ok((rows, s.stats));
+    }
+
+    let spacing = path.spacing;
+    let h_min = spacing * path.min_step_fraction;
+    let target = path.max_control;
+    let eps = 1e-12 * spacing;
+    let mut pos = 0.0f64;
+    let mut h = spacing;
+    let mut k_out = 1usize;
+    let mut prev_q = q.clone();
+    let mut prev_load = load;
+    let mut h_prev = 0.0f64;
+    let mut trial_q = vec![0.0; n];
+    let max_steps = 200 * ((target / spacing).ceil() as usize) + 20_000;
+    while pos < target - eps {
+        if s.stats.steps > max_steps {
+            return Err(fail(rows, format!("gave up after {} steps at control {pos:.6}", s.stats.steps)));
+        }
+        let next = (spacing * k_out as f64).min(target);
+        let dh = h.min(next - pos);
+        let alpha = if h_prev > 0.0 { dh / h_prev } else { 0.0 };
+        for i in 0..n {
+            trial_q[i] = q[i] + alpha * (q[i] - prev_q[i]);
+        }
+        let mut trial_load = load + alpha * (load - prev_load);
+        match s.solve(&committed, &mut trial_q, &mut trial_load, Some(c0 + pos + dh)) {
+            Some(it) => {
+                // Energies of the step, point by point.
+                let d_old = displacement(&q);
+                let d_new = displacement(&trial_q);
+                totals.external += 0.5 * (load + trial_load) * (d_new - d_old);
+                let c = p.compliance;
+                for (ip, pt) in p.points.iter().enumerate() {
+                    let (g0, t0) = (committed.law_gaps[ip], committed.tractions[ip]);
+                    let (g1, t1) = (s.trial.law_gaps[ip], s.trial.tractions[ip]);
+                    let before = &committed.points[ip];
+                    let after = &s.trial.points[ip];
+                    let mut w = if after != before {
+                        path_work(law, before, (g0, t0), (g1, t1), after, None)
+                    } else {
+                        0.5 * (t0 + t1).dot(&(g1 - g0))
+                    };
+                    if s.with_compliance {
+                        w += 0.5 * (c[0] * (t1[0] * t1[0] - t0[0] * t0[0]) + c[1] * (t1[1] * t1[1] - t0[1] * t0[1]));
+                    }
+                    totals.interface_work += pt.area * pt.factor * w;
+                }
+                for fe in &s.fibre_elements {
+                    let sec = &p.fibre_layers[fe.fl].sections[fe.section];
+                    for (k, f) in sec.fibres.iter().enumerate() {
+                        let i = fe.first + k;
+                        let m: &FibreMaterial = &sec.materials[f.material];
+                        let w = m.step_work(
+                            &committed.fibres[i],
+                            (committed.strains[i], committed.stresses[i]),
+                            (s.trial.strains[i], s.trial.stresses[i]),
+                        );
+                        totals.material_work += f.area * fe.len * w;
+                    }
+                }
+                prev_q.copy_from_slice(&q);
+                prev_load = load;
+                q.copy_from_slice(&trial_q);
+                load = trial_load;
+                committed.clone_from(&s.trial);
+                s.stats.steps += 1;
+                pos += dh;
+                h_prev = dh;
+                if it <= 4 {
+                    h = (2.0 * h).min(spacing);
+                } else if it >= 8 {
+                    h = (0.5 * h).max(h_min);
+                }
+                if (next - pos).abs() <= eps {
+                    pos = next;
+                    k_out += 1;
+                    if record(&s, &committed, &q, load, &totals, &mut rows, observe) {
+                        break;
+                    }
+                }
+            }
+            None => {
+                s.stats.cuts += 1;
+                if dh <= h_min * (1.0 + 1e-9) {
+                    return Err(fail(
+                        rows,
+                        format!("no convergence at control {:.6} with steps down to {h_min:.3e}", pos + dh),
+                    ));
+                }
+                h = (0.5 * dh).max(h_min);
+                h_prev = 0.0;
+            }
+        }
+    }
+    s.stats.assemblies = s.stats.assemblies.max(1);
+    Ok((rows, s.stats))
+}
