@@ -15,17 +15,16 @@
 //!   steel fibres (elastic, yield, linear hardening) with the concrete they displace removed,
 //!   plane sections and perfect bond of the bars. Transverse shear is linear elastic
 //!   (`G_c = E_c/2.4`, ν = 0.2; the stirrups are taken to prevent shear failure).
-//! * **Cracking: crack band.** The concrete's tension softening is regularised over the
-//!   configured crack band `h` (`section.concrete.crack_band`, 150 mm: the crack spacing), not over
-//!   the element length: each crack's fracture energy `G_F` is smeared over the band, so the
-//!   concrete between cracks still carries the tension the bond of the bars gives it (tension
-//!   stiffening) and the flexural cracks of the constant-moment region and of the shear spans
-//!   form as a distributed cracked zone whose extent follows the moment. The section's
-//!   moment–curvature relation then rises monotonically through cracking, so the response does
-//!   not depend on the element length (checked by the mesh-convergence test). Individual crack
-//!   mouths (a plate bridging a discrete opening) are not resolved: the bond stress concentrates
-//!   where the plate force changes fastest, which after the bars yield is the edge of the yielded
-//!   zone next to the load point, and IC debonding starts there.
+//! * **Cracking: discrete cracks at a configurable spacing** (`cracks.spacing`, 150 mm; the
+//!   first at `cracks.first`, by default half a spacing from mid-span, so the pattern is symmetric),
+//!   taken as formed (a stabilised crack pattern): the cracking process itself is not modelled.
+//!   Each crack is one element of length `l` (the interface element) holding the whole cracked
+//!   segment of length `s` between two cracks: its fibres see the element strain times `l/s`
+//!   (so its moment–rotation is the cracked section's moment–curvature over `s`, independent of
+//!   `l`), its concrete carries no tension. Between cracks the concrete does not crack (linear in
+//!   tension: the bond of the bars limits its tension), so the soffit's elongation concentrates
+//!   at the cracks: the plate bridges a crack mouth that opens by the bars' elongation over the
+//!   spacing, the slip concentrates on both sides of it and IC debonding starts there.
 //! * **Plate**: a Timoshenko layer (axial, bending, shear) of `b_f × t_f` under the soffit,
 //!   from mid-span to its end, joined to the beam by nodal interface points (trapezoidal weights,
 //!   `b_f` × tributary length) carrying any [`CohesiveLaw`] in mixed mode: slip from the
