@@ -71,6 +71,11 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Diagnose the sim-to-real gap: where the fitted model misses, which unmodelled effect most
+    /// likely causes it, how far the misfit shrinks with it (gap.json, report.md, plots).
+    Diagnose(commands::diagnose::DiagnoseArgs),
+    /// Check the diagnosis on planted-effect synthetic cases (confusion matrix, accuracy, false alarms).
+    GapBench(commands::gap_bench::GapBenchArgs),
     /// Benchmark optimizers on standard test functions (optimizers × problems × seeds).
     Harness(commands::harness::HarnessArgs),
     /// Compare optimizers over several seeds at equal budgets.
@@ -130,6 +135,8 @@ fn main() -> ExitCode {
             run_identify(&problem, &set.sets, &out, &opts)
         }
         Command::Harness(args) => commands::harness::run(&args),
+        Command::Diagnose(args) => commands::diagnose::run(&args),
+        Command::GapBench(args) => commands::gap_bench::run(&args),
         Command::Synthesize { truth, out, force } => run_synthesize(&truth, &out, force),
         Command::Compare { problem, optimizers, seeds, budget, target, out, set } => {
             run_compare(&problem, &set.sets, &out, &CompareOptions { optimizers, seeds, budget, target })

@@ -66,26 +66,31 @@ pub struct Assessment {
     pub correlations: Vec<f64>,
     /// Singular values of J (descending).
     pub singular_values: Vec<f64>,
+    /// Sensitivity of the residuals to each parameter: the root mean square of its Jacobian
+    /// column (residual units per unit of the parameter's range).
+    pub sensitivities: Vec<f64>,
+    /// Collinearity index of the sensitive parameters (Brun et al., Water Res. 35 (2001) 1483):
+    /// `1/√λ_min` of the Gram matrix of the unit-normalised Jacobian columns. 1: orthogonal;
+    /// above ~10–15 some combination of the parameters is poorly determined.
+    pub collinearity_index: f64,
 }
+
+/// Step of the central differences of [`assess`], in unit-cube coordinates.
+pub const FD_STEP: f64 = STEP;
 
 /// Assesses the parameters at unit-cube point `u`.
 pub fn assess(id: &Identification, u: &[f64]) -> Result<Assessment> {
+    let residuals = |w: &[f64]| -> Result<Vec<f64>> { Ok(id.simulate(&id.space().from_unit(w))?.evaluation.residuals) };
+    let r0 = residuals(u)?;
+    let jac = crate::diagnose::lsq::jacobian(&residuals, u, STEP)?;
+    Ok(assess_jacobian(id.space(), u, &r0, &jac))
+}
+
+/// Assesses the parameters of `space` at unit-cube point `u` from the residuals `r0` there and
+/// their Jacobian `jac` (n × p, unit-cube coordinates).
+pub fn assess_jacobian(space: &ParameterSpace, u: &[f64], r0: &[f64], jac: &DMatrix<f64>) -> Assessment {
     let p = u.len();
-    let r0 = id.simulate(&id.space().from_unit(u))?.evaluation.residuals;
     let n = r0.len();
-    let mut jac = DMatrix::<f64>::zeros(n, p);
-    for j in 0..p {
-        let (lo, hi) = ((u[j] - STEP).max(0.0), (u[j] + STEP).min(1.0));
-        let eval = |v: f64| -> Result<Vec<f64>> {
-            let mut w = u.to_vec();
-            w[j] = v;
-            Ok(id.simulate(&id.space().from_unit(&w))?.evaluation.residuals)
-        };
-        let (rl, rh) = (eval(lo)?, eval(hi)?);
-        for i in 0..n {
-            jac[(i, j)] = (rh[i] - rl[i]) / (hi - lo);
-        }
-    }
     let norms: Vec<f64> = (0..p).map(|j| jac.column(j).norm()).collect();
     let largest = norms.iter().cloned().fold(0.0, f64::max);
     let insensitive: Vec<bool> = norms.iter().map(|&s| s <= NEGLIGIBLE * largest || s == 0.0).collect();
@@ -112,7 +117,7 @@ pub fn assess(id: &Identification, u: &[f64]) -> Result<Assessment> {
             correlations[a * p + b] = cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt();
         }
     }
-    let params = id.space().parameters();
+    let params = space.parameters();
     let mut verdicts = Vec::with_capacity(p);
     let mut standard_errors = Vec::with_capacity(p);
     for j in 0..p {
@@ -144,5 +149,18 @@ pub fn assess(id: &Identification, u: &[f64]) -> Result<Assessment> {
         });
         verdicts.push(verdict);
     }
-    Ok(Assessment { verdicts, standard_errors, correlations, singular_values })
+    let sensitivities = norms.iter().map(|s| s / (n.max(1) as f64).sqrt()).collect();
+    let collinearity_index = if keep.is_empty() {
+        f64::NAN
+    } else {
+        let normalised = DMatrix::from_fn(n, keep.len(), |i, a| jac[(i, keep[a])] / norms[keep[a]]);
+        let gram = normalised.transpose() * &normalised;
+        let lmin = gram.symmetric_eigenvalues().iter().cloned().fold(f64::INFINITY, f64::min);
+        if lmin > 0.0 {
+            1.0 / lmin.sqrt()
+        } else {
+            f64::INFINITY
+        }
+    };
+    Assessment { verdicts, standard_errors, correlations, singular_values, sensitivities, collinearity_index }
 }

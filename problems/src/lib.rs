@@ -4,6 +4,8 @@
 //! * [`data`]: experimental curves from CSV, checked and converted to N and mm.
 //! * [`identification`]: a shared law, per-experiment forward models, parameters and the
 //!   composite objective as a [`czid_core::Problem`] on the unit cube.
+//! * [`diagnose`]: where a fitted model misses the test, which unmodelled effect most likely
+//!   causes it, and how far the misfit shrinks once it is added.
 //! * [`identify`]: the `identify` and `simulate` workflows, writing results, fits and plots.
 //! * [`identifiability`]: standard errors, correlations and a verdict per identified parameter.
 //! * [`output`]: output folders that are never clobbered by accident, files written atomically.
@@ -13,6 +15,7 @@
 
 pub mod compare;
 pub mod data;
+pub mod diagnose;
 pub mod identifiability;
 pub mod identification;
 pub mod identify;

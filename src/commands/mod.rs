@@ -1,1 +1,3 @@
+pub mod diagnose;
+pub mod gap_bench;
 pub mod harness;

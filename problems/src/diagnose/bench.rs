@@ -1,0 +1,1 @@
+//! Planted-effect cases (placeholder, filled below).

@@ -1,0 +1,207 @@
+//! The misfit measured in units of the measurement noise: every reading of every response becomes
+//! `(test − model) / σ`, σ that response's noise, so that sums of squares are χ²-like and the
+//! score statistics of the candidate effects can be compared with their χ² thresholds.
+
+use crate::data::Experiment;
+use crate::diagnose::noise;
+use crate::identification::{Setup, Term};
+use czid_core::{columns, CzError, Record, Result};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// One measured response of one experiment.
+#[derive(Clone, Debug, Serialize)]
+pub struct Block {
+    /// Experiment name.
+    pub experiment: String,
+    /// `F` (load, N) or `L` (debonded length, mm).
+    pub term: String,
+    /// Displacements of the readings (mm).
+    pub x: Vec<f64>,
+    /// Measured values (N or mm).
+    pub y: Vec<f64>,
+    /// Noise standard deviation (N or mm).
+    pub sigma: f64,
+    /// Whether σ was estimated from the data (false: given by the user).
+    pub sigma_estimated: bool,
+}
+
+/// Noise levels given instead of estimated.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NoiseLevels {
+    /// Load noise (N).
+    pub load: Option<f64>,
+    /// Debonded-length noise (mm).
+    pub length: Option<f64>,
+}
+
+/// The responses a diagnosis compares, with their noise.
+#[derive(Clone, Debug)]
+pub struct Gauge {
+    /// Blocks in residual order.
+    pub blocks: Vec<Block>,
+}
+
+/// A setup's misfit.
+#[derive(Debug)]
+pub struct Misfit {
+    /// `(test − model) / σ`, blocks concatenated.
+    pub r: Vec<f64>,
+    /// Records per experiment (partial when a run stopped early).
+    pub records: BTreeMap<String, Record>,
+    /// Messages of runs that stopped early.
+    pub failures: Vec<String>,
+}
+
+impl Misfit {
+    /// Sum of squares (χ²-like).
+    pub fn rss(&self) -> f64 {
+        self.r.iter().map(|v| v * v).sum()
+    }
+}
+
+impl Gauge {
+    /// The load curve of every experiment and, with `use_length`, its debonded-length curve when
+    /// measured; noise estimated from each curve unless given.
+    pub fn new(experiments: &[Experiment], use_length: bool, noise_levels: NoiseLevels) -> Result<Self> {
+        let mut blocks = Vec::new();
+        for e in experiments {
+            let (x, y) = (e.load.x().to_vec(), e.load.y().to_vec());
+            let sigma = noise_levels.load.unwrap_or_else(|| noise::estimate(&x, &y, false));
+            blocks.push(Block {
+                experiment: e.name.clone(),
+                term: Term::Load.symbol().into(),
+                x,
+                y,
+                sigma,
+                sigma_estimated: noise_levels.load.is_none(),
+            });
+            if let (true, Some(l)) = (use_length, &e.debonded_length) {
+                if l.norm() > 0.0 {
+                    let (x, y) = (l.x().to_vec(), l.y().to_vec());
+                    let sigma = noise_levels.length.unwrap_or_else(|| noise::estimate(&x, &y, true));
+                    blocks.push(Block {
+                        experiment: e.name.clone(),
+                        term: Term::DebondedLength.symbol().into(),
+                        x,
+                        y,
+                        sigma,
+                        sigma_estimated: noise_levels.length.is_none(),
+                    });
+                }
+            }
+        }
+        for b in &blocks {
+            if !(b.sigma > 0.0 && b.sigma.is_finite()) {
+                return Err(CzError::invalid(
+                    format!("noise of {}:{}", b.term, b.experiment),
+                    "sigma",
+                    b.sigma,
+                    "must be positive and finite (give it with --noise-load / --noise-length)",
+                ));
+            }
+        }
+        Ok(Gauge { blocks })
+    }
+
+    /// Number of readings.
+    pub fn len(&self) -> usize {
+        self.blocks.iter().map(|b| b.x.len()).sum()
+    }
+
+    /// Whether there are no readings.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The same responses restricted to readings whose displacement satisfies `keep(experiment,
+    /// x)` (e.g. a held-out part of the curve). Blocks left with no reading are dropped.
+    pub fn restricted(&self, keep: impl Fn(&str, f64) -> bool) -> Gauge {
+        let blocks = self
+            .blocks
+            .iter()
+            .filter_map(|b| {
+                let idx: Vec<usize> = (0..b.x.len()).filter(|&i| keep(&b.experiment, b.x[i])).collect();
+                (!idx.is_empty()).then(|| Block {
+                    x: idx.iter().map(|&i| b.x[i]).collect(),
+                    y: idx.iter().map(|&i| b.y[i]).collect(),
+                    ..b.clone()
+                })
+            })
+            .collect();
+        Gauge { blocks }
+    }
+
+    /// Positions in the residual vector of the readings [`Gauge::restricted`] keeps with `keep`.
+    pub fn rows(&self, keep: impl Fn(&str, f64) -> bool) -> Vec<usize> {
+        let mut out = Vec::new();
+        for (b, range) in self.blocks.iter().zip(self.ranges()) {
+            out.extend(range.zip(&b.x).filter(|(_, &x)| keep(&b.experiment, x)).map(|(i, _)| i));
+        }
+        out
+    }
+
+    /// Model value of a block's response at its readings.
+    pub fn model_values(block: &Block, record: &Record) -> Result<Vec<f64>> {
+        let column = if block.term == Term::Load.symbol() { columns::LOAD } else { columns::DEBONDED_LENGTH };
+        let curve = record.curve(columns::DISPLACEMENT, column)?;
+        Ok(curve.sample(&block.x))
+    }
+
+    /// Simulates every experiment of `setup` that the gauge measures and returns the misfit.
+    /// A run that stops part way is compared on its converged steps (its last value held), as in
+    /// an identification; a run with fewer than two steps is an error.
+    pub fn evaluate(&self, setup: &Setup) -> Result<Misfit> {
+        let mut names: Vec<&str> = self.blocks.iter().map(|b| b.experiment.as_str()).collect();
+        names.dedup();
+        let runs: Vec<Result<(String, Record, Option<String>)>> = names
+            .par_iter()
+            .map(|name| {
+                let model = setup.models.get(*name).ok_or_else(|| {
+                    CzError::config(format!("experiment `{name}`"), "has no forward model in the setup")
+                })?;
+                match model.simulate(setup.law.as_ref()) {
+                    Ok(r) => Ok((name.to_string(), r, None)),
+                    Err(f) if f.partial.rows() >= 2 => {
+                        let message = format!("{name}: {f}");
+                        Ok((name.to_string(), f.partial, Some(message)))
+                    }
+                    Err(f) => Err(CzError::Simulation(format!("{name}: {f}"))),
+                }
+            })
+            .collect();
+        let mut records = BTreeMap::new();
+        let mut failures = Vec::new();
+        for run in runs {
+            let (name, record, failure) = run?;
+            failures.extend(failure);
+            records.insert(name, record);
+        }
+        let mut r = Vec::with_capacity(self.len());
+        for b in &self.blocks {
+            let model = Self::model_values(b, &records[&b.experiment])?;
+            r.extend(b.y.iter().zip(&model).map(|(y, m)| (y - m) / b.sigma));
+        }
+        Ok(Misfit { r, records, failures })
+    }
+
+    /// [`Gauge::evaluate`] for many setups in parallel (results in input order, so the outcome
+    /// does not depend on the number of threads).
+    pub fn evaluate_all(&self, setups: &[Setup]) -> Vec<Result<Misfit>> {
+        setups.par_iter().map(|s| self.evaluate(s)).collect()
+    }
+
+    /// Index ranges of the blocks in the residual vector.
+    pub fn ranges(&self) -> Vec<std::ops::Range<usize>> {
+        let mut start = 0;
+        self.blocks
+            .iter()
+            .map(|b| {
+                let r = start..start + b.x.len();
+                start = r.end;
+                r
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,26 @@
+//! Diagnosing the sim-to-real gap: where a fitted model misses the test, which unmodelled effect
+//! most likely causes it, and how far the misfit shrinks once that effect is added, checked on
+//! data withheld from the fit.
+//!
+//! * [`gauge`]: the misfit in units of the measurement noise ([`noise`]: estimated from the data).
+//! * [`regimes`]: the test split into regimes from its load curve; misfit and sign per regime.
+//! * [`candidate`]: the [`CandidateEffect`] plug-in trait and the bundled [`Library`].
+//! * [`score`]: score statistics at the base fit, confounding, absorbing parameter.
+//! * [`lsq`]: bounded Levenberg–Marquardt for the base polish and the refits.
+//! * [`run`]: the whole diagnosis ([`run::diagnose`]) and its report ([`report`]).
+//! * [`bench`]: planted-effect cases with a known answer.
+
+pub mod bench;
+pub mod candidate;
+pub mod gauge;
+pub mod lsq;
+pub mod noise;
+pub mod regimes;
+pub mod report;
+pub mod run;
+pub mod score;
+pub mod stats;
+
+pub use candidate::{BridgingTail, CandidateEffect, EffectParameter, Library, ModelField, ModelFlag};
+pub use gauge::{Gauge, NoiseLevels};
+pub use run::{diagnose, Diagnosis, Options};

@@ -1,0 +1,770 @@
+//! The whole diagnosis: base fit, where, identifiability, which, how far, transfer, verdict.
+
+use crate::diagnose::candidate::{CandidateEffect, Library};
+use crate::diagnose::gauge::{Gauge, Misfit, NoiseLevels};
+use crate::diagnose::lsq::{self, LsOptions};
+use crate::diagnose::regimes::{self, Regime, RegimeMisfit};
+use crate::diagnose::score::{self, Linearisation, Score, Sensitivity};
+use crate::diagnose::stats::chi2_survival;
+use crate::identifiability::{assess_jacobian, FD_STEP};
+use crate::identification::Setup;
+use crate::identify::optimize;
+use crate::problem_file::LoadedProblem;
+use czid_core::{Budget, CzError, Observer, Parameter, ParameterSpace, Progress, Record, Result};
+use nalgebra::DMatrix;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Significance of the base misfit against the noise (χ² with n − p degrees of freedom).
+const NOISE_LEVEL: f64 = 1e-3;
+/// Cosine above which two candidates are reported as confusable.
+pub const CONFUSABLE: f64 = 0.9;
+
+/// What to diagnose and how.
+pub struct Options {
+    /// Candidates to score (names in the library; empty: every one that applies).
+    pub candidates: Vec<String>,
+    /// Fitted values to start from (physical, in the problem's parameter order), e.g. from an
+    /// `identify` result; `None`: fit with the problem file's optimizer first.
+    pub start: Option<Vec<f64>>,
+    /// How many of the best-scoring candidates to refit.
+    pub refit: usize,
+    /// Noise levels instead of estimates from the data.
+    pub noise: NoiseLevels,
+    /// Other tests predicted with the calibrated parameters (transfer), e.g. other specimens.
+    pub withheld: Vec<LoadedProblem>,
+    /// Also check transfer to the held-out late stage of each curve.
+    pub holdout: bool,
+    /// Called with a short message as each stage starts (e.g. for a progress display).
+    pub progress: Option<Box<dyn Fn(&str) + Sync>>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            candidates: Vec::new(),
+            start: None,
+            refit: 3,
+            noise: NoiseLevels::default(),
+            withheld: Vec::new(),
+            holdout: true,
+            progress: None,
+        }
+    }
+}
+
+/// A physical value with its unit.
+#[derive(Clone, Debug, Serialize)]
+pub struct Value {
+    /// Parameter path or label.
+    pub name: String,
+    /// Value.
+    pub value: f64,
+    /// Unit.
+    pub unit: String,
+}
+
+/// A fitted parameter and what the data say about it.
+#[derive(Clone, Debug, Serialize)]
+pub struct FittedParameter {
+    /// Path.
+    pub path: String,
+    /// Value.
+    pub value: f64,
+    /// Unit.
+    pub unit: String,
+    /// Standard error (same unit), when defined.
+    pub standard_error: Option<f64>,
+    /// Sensitivity: RMS of its Jacobian column (noise units per range).
+    pub sensitivity: f64,
+    /// Plain verdict.
+    pub verdict: String,
+}
+
+/// Identifiability of the fitted parameters at the base fit.
+#[derive(Clone, Debug, Serialize)]
+pub struct Identifiability {
+    /// Singular values of the Jacobian (noise units, unit-cube coordinates).
+    pub singular_values: Vec<f64>,
+    /// Collinearity index (1: orthogonal; above ~10–15: a poorly determined combination).
+    pub collinearity_index: f64,
+    /// Correlation matrix, row by row.
+    pub correlations: Vec<Vec<f64>>,
+}
+
+/// The base fit.
+#[derive(Clone, Debug, Serialize)]
+pub struct BaseFit {
+    /// Fitted parameters.
+    pub parameters: Vec<FittedParameter>,
+    /// Sum of squared residuals in noise units.
+    pub chi2: f64,
+    /// `chi2 / (n − p)`: 1 at the noise level.
+    pub reduced_chi2: f64,
+    /// `P(χ²_{n−p} > chi2)`.
+    pub p_value: f64,
+    /// Whether the misfit is consistent with the noise alone.
+    pub at_noise_level: bool,
+    /// Residual evaluations of the fit (after the file's optimizer, if run).
+    pub evaluations: usize,
+    /// Runs that stopped early at the fit.
+    pub failures: Vec<String>,
+}
+
+/// Shrinkage of the misfit in one regime.
+#[derive(Clone, Debug, Serialize)]
+pub struct RegimeShrinkage {
+    /// Experiment.
+    pub experiment: String,
+    /// Regime.
+    pub regime: String,
+    /// χ² of the base fit there.
+    pub before: f64,
+    /// χ² with the effect.
+    pub after: f64,
+    /// `1 − after/before`.
+    pub shrinkage: f64,
+}
+
+/// A refit with the effect switched on.
+#[derive(Clone, Debug, Serialize)]
+pub struct Refit {
+    /// Fitted parameters.
+    pub parameters: Vec<Value>,
+    /// Effect parameters.
+    pub effect: Vec<Value>,
+    /// χ² (noise units).
+    pub chi2: f64,
+    /// Realised shrinkage `1 − χ²/χ²_base`.
+    pub shrinkage: f64,
+    /// Per regime.
+    pub by_regime: Vec<RegimeShrinkage>,
+    /// Akaike information criterion `n ln(χ²/n) + 2k`.
+    pub aic: f64,
+    /// Bayesian information criterion `n ln(χ²/n) + k ln n`.
+    pub bic: f64,
+    /// AIC − AIC of the base (negative: the effect is worth its parameters).
+    pub delta_aic: f64,
+    /// BIC − BIC of the base.
+    pub delta_bic: f64,
+    /// Residual evaluations.
+    pub evaluations: usize,
+}
+
+/// Prediction of withheld data with and without the effect.
+#[derive(Clone, Debug, Serialize)]
+pub struct Transfer {
+    /// What was withheld.
+    pub withheld: String,
+    /// Readings predicted.
+    pub readings: usize,
+    /// χ² of the prediction without the effect.
+    pub base_chi2: f64,
+    /// χ² with the effect (None when the effect does not carry over).
+    pub effect_chi2: Option<f64>,
+    /// `1 − effect/base`.
+    pub shrinkage: Option<f64>,
+    /// Why the effect does not carry over, when it does not.
+    pub note: Option<String>,
+}
+
+/// One candidate's results.
+#[derive(Clone, Debug, Serialize)]
+pub struct CandidateResult {
+    /// Name.
+    pub name: String,
+    /// The physics.
+    pub description: String,
+    /// Score at the base fit (None when it could not be evaluated).
+    pub score: Option<Score>,
+    /// Why it has no score.
+    pub error: Option<String>,
+    /// Refit with the effect on (the best-scoring candidates only).
+    pub refit: Option<Refit>,
+    /// Transfer to withheld data.
+    pub transfer: Vec<Transfer>,
+}
+
+/// A pair of candidates the data cannot tell apart.
+#[derive(Clone, Debug, Serialize)]
+pub struct Confusable {
+    /// First candidate.
+    pub a: String,
+    /// Second candidate.
+    pub b: String,
+    /// Cosine between their sensitivities once the fitted parameters' span is removed.
+    pub cos: f64,
+}
+
+/// Noise level of one response.
+#[derive(Clone, Debug, Serialize)]
+pub struct NoiseReport {
+    /// Experiment.
+    pub experiment: String,
+    /// `F` or `L`.
+    pub term: String,
+    /// Standard deviation.
+    pub sigma: f64,
+    /// `N` or `mm`.
+    pub unit: String,
+    /// Estimated from the data (false: given).
+    pub estimated: bool,
+}
+
+/// Everything `gap.json` holds.
+#[derive(Debug, Serialize)]
+pub struct Diagnosis {
+    /// Problem file.
+    pub problem: String,
+    /// Readings compared.
+    pub readings: usize,
+    /// Noise per response.
+    pub noise: Vec<NoiseReport>,
+    /// The base fit.
+    pub base: BaseFit,
+    /// Regimes per experiment.
+    pub regimes: Vec<Regime>,
+    /// Misfit per experiment, regime and response.
+    pub misfit: Vec<RegimeMisfit>,
+    /// Identifiability of the fitted parameters.
+    pub identifiability: Identifiability,
+    /// Candidates, best score first.
+    pub candidates: Vec<CandidateResult>,
+    /// Candidates that do not apply, with the reason.
+    pub skipped: Vec<(String, String)>,
+    /// Pairs of candidates the data cannot tell apart.
+    pub confusable: Vec<Confusable>,
+    /// Plain-words verdict.
+    pub verdict: String,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+    /// Records of the base fit (for plots).
+    #[serde(skip)]
+    pub base_records: BTreeMap<String, Record>,
+    /// Records of the best candidate's refit (for plots).
+    #[serde(skip)]
+    pub best_records: Option<(String, BTreeMap<String, Record>)>,
+    /// Residuals of the base fit (noise units, blocks as in the gauge).
+    #[serde(skip)]
+    pub base_residuals: Vec<f64>,
+    /// The gauge.
+    #[serde(skip)]
+    pub gauge: Option<Gauge>,
+}
+
+struct Quiet;
+impl Observer for Quiet {
+    fn observe(&mut self, _: &Progress<'_>) -> bool {
+        true
+    }
+}
+
+fn aic_bic(chi2: f64, n: usize, k: usize) -> (f64, f64) {
+    let n = n as f64;
+    let l = n * (chi2.max(f64::MIN_POSITIVE) / n).ln();
+    (l + 2.0 * k as f64, l + k as f64 * n.ln())
+}
+
+/// The fitted model on the base setup, as a residual function of unit-cube coordinates.
+fn base_residuals<'a>(
+    gauge: &'a Gauge,
+    base: &'a Setup,
+    space: &'a ParameterSpace,
+) -> impl Fn(&[f64]) -> Result<Vec<f64>> + Sync + 'a {
+    move |u: &[f64]| Ok(gauge.evaluate(&space.apply(base, &space.from_unit(u))?)?.r)
+}
+
+/// A candidate's extended model: fitted parameters then the effect's, unit-cube coordinates.
+fn extended<'a>(
+    gauge: &'a Gauge,
+    base: &'a Setup,
+    space: &'a ParameterSpace,
+    c: &'a dyn CandidateEffect,
+    params: &'a [Parameter],
+) -> impl Fn(&[f64]) -> Result<Misfit> + Sync + 'a {
+    move |v: &[f64]| {
+        let p = space.dim();
+        let fitted = space.apply(base, &space.from_unit(&v[..p]))?;
+        let values: Vec<f64> = params.iter().zip(&v[p..]).map(|(q, &u)| q.from_unit(u)).collect();
+        gauge.evaluate(&c.apply(&fitted, &values)?)
+    }
+}
+
+struct RefitOutcome {
+    v: Vec<f64>,
+    misfit: Misfit,
+    evaluations: usize,
+    jacobian: Option<DMatrix<f64>>,
+}
+
+/// Refits a candidate on `gauge` from `start` (fitted and effect coordinates).
+fn refit_on(
+    gauge: &Gauge,
+    base: &Setup,
+    space: &ParameterSpace,
+    c: &dyn CandidateEffect,
+    params: &[Parameter],
+    start: &[f64],
+    jacobian: Option<DMatrix<f64>>,
+) -> Result<RefitOutcome> {
+    let model = extended(gauge, base, space, c, params);
+    let f = |v: &[f64]| Ok(model(v)?.r);
+    // A switch stays on; only the fitted parameters move.
+    let fixed: Vec<usize> = if c.discrete() { (space.dim()..start.len()).collect() } else { Vec::new() };
+    let res = lsq::minimize_from(&f, start, &fixed, &REFIT, jacobian)?;
+    let misfit = model(&res.u)?;
+    Ok(RefitOutcome { v: res.u, misfit, evaluations: res.evaluations, jacobian: res.jacobian })
+}
+
+/// Refits start from the sensitivities of the scores and follow them with Broyden updates: one
+/// run per step (a large-rotation run costs ~50 small-rotation ones), one fresh finite-difference
+/// Jacobian if they stall.
+const REFIT: LsOptions = LsOptions { max_iterations: 15, step: 2e-3, tolerance: 1e-6, fd_jacobians: 1 };
+
+fn select_rows(m: &DMatrix<f64>, rows: &[usize]) -> DMatrix<f64> {
+    DMatrix::from_fn(rows.len(), m.ncols(), |i, j| m[(rows[i], j)])
+}
+
+/// Diagnoses `problem` with the candidates of `library`.
+pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> Result<Diagnosis> {
+    let clock = Instant::now();
+    let say = |m: &str| {
+        if let Some(p) = &opts.progress {
+            p(m)
+        }
+    };
+    let chosen = library.select(&opts.candidates)?;
+    let id = problem.identification()?;
+    let space = id.space().clone();
+    let base = id.setup().duplicate()?;
+    let gauge = Gauge::new(&problem.experiments, problem.file.objective.debonded_length, opts.noise)?;
+    let n = gauge.len();
+    let p = space.dim();
+
+    // 1. Base fit: the file's optimizer (unless a result is given), then a polish on the misfit in
+    //    noise units, which is what every statistic below assumes.
+    let u0 = match &opts.start {
+        Some(x) => {
+            if x.len() != p {
+                return Err(CzError::config("--from", format!("{} values for the problem's {p} parameters", x.len())));
+            }
+            space.check_within(x).map_err(|e| CzError::config("--from", e.to_string()))?;
+            space.to_unit(x)
+        }
+        None => {
+            say("fitting the base model with the problem file's optimizer");
+            let spec = &problem.file.optimizer;
+            let budget = Budget { evaluations: spec.budget, target: spec.target };
+            let run = optimize(
+                &id,
+                &spec.kind,
+                &toml::Value::Table(spec.settings.clone()),
+                spec.seed,
+                &budget,
+                None,
+                &mut Quiet,
+            )?;
+            run.result.best_x
+        }
+    };
+    say("polishing the base fit on the misfit in noise units");
+    let f = base_residuals(&gauge, &base, &space);
+    let fit = lsq::minimize(&f, &u0, &[], &LsOptions::default())?;
+    let u = fit.u.clone();
+    let x = space.from_unit(&u);
+    let fitted = space.apply(&base, &x)?;
+    let misfit = gauge.evaluate(&fitted)?;
+    let chi2 = misfit.rss();
+    let dof = n.saturating_sub(p).max(1);
+    let p_noise = chi2_survival(chi2, dof as f64);
+
+    // 2. Where.
+    let regs = regimes::split_all(&gauge);
+    let by_regime = regimes::misfit_by_regime(&gauge, &regs, &misfit);
+
+    // 3. Identifiability.
+    say("identifiability of the fitted parameters");
+    let jac = lsq::jacobian(&f, &u, FD_STEP)?;
+    let assessment = assess_jacobian(&space, &u, &misfit.r, &jac);
+    let parameters = space
+        .parameters()
+        .iter()
+        .enumerate()
+        .map(|(j, q)| FittedParameter {
+            path: q.path.clone(),
+            value: x[j],
+            unit: q.unit.clone(),
+            standard_error: assessment.standard_errors[j],
+            sensitivity: assessment.sensitivities[j],
+            verdict: assessment.verdicts[j].describe(&space),
+        })
+        .collect();
+    let identifiability = Identifiability {
+        singular_values: assessment.singular_values.clone(),
+        collinearity_index: assessment.collinearity_index,
+        correlations: (0..p).map(|a| (0..p).map(|b| assessment.correlations[a * p + b]).collect()).collect(),
+    };
+    let lin = Linearisation::new(&misfit.r, jac);
+
+    // 4. Which.
+    let mut skipped = Vec::new();
+    let applicable: Vec<&dyn CandidateEffect> = chosen
+        .into_iter()
+        .filter(|c| {
+            let ok = c.applies(&fitted);
+            if !ok {
+                skipped.push((
+                    c.name().to_string(),
+                    "does not apply to this setup (other model type or law, or already switched on)".to_string(),
+                ));
+            }
+            ok
+        })
+        .collect();
+    say(&format!("scoring {} candidate effects", applicable.len()));
+    let sens = score::sensitivities(&gauge, &fitted, &misfit.r, &applicable);
+    let tests = applicable.len();
+    let mut results: Vec<(CandidateResult, Option<Sensitivity>, &dyn CandidateEffect)> = applicable
+        .iter()
+        .zip(sens)
+        .map(|(c, s)| {
+            let (score, error, sens) = match s {
+                Ok(s) => (Some(score::score(&lin, &s, &space, &u, tests)), None, Some(s)),
+                Err(e) => (None, Some(e), None),
+            };
+            (
+                CandidateResult {
+                    name: c.name().into(),
+                    description: c.describe(),
+                    score,
+                    error,
+                    refit: None,
+                    transfer: Vec::new(),
+                },
+                sens,
+                *c,
+            )
+        })
+        .collect();
+    results.sort_by(|a, b| {
+        let s = |r: &CandidateResult| r.score.as_ref().map_or(-1.0, |s| s.statistic);
+        s(&b.0).total_cmp(&s(&a.0))
+    });
+    let mut confusable = Vec::new();
+    for i in 0..results.len() {
+        for j in i + 1..results.len() {
+            if let (Some(a), Some(b)) = (&results[i].1, &results[j].1) {
+                let cos = score::confusability(&lin, a, b);
+                if cos > CONFUSABLE {
+                    confusable.push(Confusable { a: a.name.clone(), b: b.name.clone(), cos });
+                }
+            }
+        }
+    }
+
+    // 5. How far: refits and transfer.
+    let (base_aic, base_bic) = aic_bic(chi2, n, p);
+    let base_regime_chi2 = regimes::rss_by_regime(&gauge, &regs, &misfit.r);
+    let split = |exp: &str| -> f64 {
+        regs.iter().find(|r| r.experiment == exp && r.name == regimes::NAMES[3]).map(|r| r.from).unwrap_or_else(|| {
+            let b = gauge.blocks.iter().find(|b| b.experiment == exp).expect("experiment has a block");
+            b.x[0] + 0.75 * (b.x[b.x.len() - 1] - b.x[0])
+        })
+    };
+    let early = gauge.restricted(|e, x| x < split(e));
+    let early_rows = gauge.rows(|e, x| x < split(e));
+    let late = gauge.restricted(|e, x| x >= split(e));
+    let holdout_base = if opts.holdout && !late.is_empty() && !early.is_empty() {
+        say("base fit without the late stage (held out)");
+        let fe = base_residuals(&early, &base, &space);
+        let r = lsq::minimize_from(&fe, &u, &[], &REFIT, Some(select_rows(&lin.jac, &early_rows)))?;
+        let predicted = late.evaluate(&space.apply(&base, &space.from_unit(&r.u))?)?;
+        Some(predicted.rss())
+    } else {
+        None
+    };
+    let withheld_base: Vec<(String, Gauge, Setup, ParameterSpace, Vec<f64>, f64)> = opts
+        .withheld
+        .iter()
+        .map(|w| {
+            let g = Gauge::new(&w.experiments, w.file.objective.debonded_length, opts.noise)?;
+            let setup = w.setup()?;
+            // Only the parameters that exist in the withheld setup carry over (a law, a shared
+            // modulus), not another specimen's own.
+            let idx: Vec<usize> = (0..p)
+                .filter(|&j| {
+                    ParameterSpace::new(vec![space.parameters()[j].clone()]).and_then(|s| s.read(&setup)).is_ok()
+                })
+                .collect();
+            let sub = ParameterSpace::new(idx.iter().map(|&j| space.parameters()[j].clone()).collect())?;
+            let xs: Vec<f64> = idx.iter().map(|&j| x[j]).collect();
+            let chi = g.evaluate(&sub.apply(&setup, &xs)?)?.rss();
+            Ok((w.path.display().to_string(), g, setup, sub, idx.iter().map(|&j| j as f64).collect(), chi))
+        })
+        .collect::<Result<_>>()?;
+
+    let mut best_records = None;
+    let top: Vec<usize> = (0..results.len())
+        .filter(|&i| results[i].0.score.as_ref().is_some_and(|s| s.dof > 0))
+        .take(opts.refit)
+        .collect();
+    for &i in &top {
+        let (res, sens, c) = &mut results[i];
+        let sens = sens.as_ref().expect("scored candidates have a sensitivity");
+        let s = res.score.as_ref().expect("scored");
+        say(&format!("refitting with {}", c.name()));
+        let params: Vec<Parameter> = sens.parameters.iter().map(|q| q.parameter.clone()).collect();
+        let null_start: Vec<f64> = u.iter().copied().chain(sens.null_u.iter().copied()).collect();
+        // The joint first-order prediction: the effect at the size the data ask for, the fitted
+        // parameters moved by what they no longer have to absorb.
+        let shifted = u.iter().zip(&s.fitted_shift).map(|(a, b)| (a + b).clamp(0.0, 1.0));
+        let start: Vec<f64> = if c.discrete() {
+            shifted.chain(std::iter::repeat_n(1.0, params.len())).collect()
+        } else {
+            shifted.chain(params.iter().zip(&s.predicted).map(|(q, v)| q.to_unit(v.1).clamp(0.0, 1.0))).collect()
+        };
+        let model = extended(&gauge, &base, &space, *c, &params);
+        // The first-order size is a good start unless the response is strongly non-linear in it.
+        let start = match model(&start) {
+            Ok(m) if m.rss() <= chi2 => start,
+            _ if c.discrete() => u.iter().copied().chain(std::iter::repeat_n(1.0, params.len())).collect(),
+            _ => null_start,
+        };
+        let jac0 = if c.discrete() {
+            lin.jac.clone()
+        } else {
+            let mut m = DMatrix::zeros(n, p + params.len());
+            m.columns_mut(0, p).copy_from(&lin.jac);
+            m.columns_mut(p, params.len()).copy_from(&sens.columns);
+            m
+        };
+        let out = match refit_on(&gauge, &base, &space, *c, &params, &start, Some(jac0)) {
+            Ok(o) => o,
+            Err(e) => {
+                res.error = Some(format!("refit failed: {e}"));
+                continue;
+            }
+        };
+        let k = p + if c.discrete() { 1 } else { sens.columns.ncols() };
+        let chi = out.misfit.rss();
+        let (aic, bic) = aic_bic(chi, n, k);
+        let after = regimes::rss_by_regime(&gauge, &regs, &out.misfit.r);
+        let by_regime = regs
+            .iter()
+            .zip(base_regime_chi2.iter().zip(&after))
+            .map(|(g, (b, a))| RegimeShrinkage {
+                experiment: g.experiment.clone(),
+                regime: g.name.clone(),
+                before: *b,
+                after: *a,
+                shrinkage: if *b > 0.0 { 1.0 - a / b } else { 0.0 },
+            })
+            .collect();
+        let xv = space.from_unit(&out.v[..p]);
+        let ev: Vec<f64> = params.iter().zip(&out.v[p..]).map(|(q, &w)| q.from_unit(w)).collect();
+        res.refit = Some(Refit {
+            parameters: space
+                .parameters()
+                .iter()
+                .zip(&xv)
+                .map(|(q, &v)| Value { name: q.path.clone(), value: v, unit: q.unit.clone() })
+                .collect(),
+            effect: params
+                .iter()
+                .zip(&ev)
+                .map(|(q, &v)| Value { name: q.path.clone(), value: v, unit: q.unit.clone() })
+                .collect(),
+            chi2: chi,
+            shrinkage: 1.0 - chi / chi2.max(f64::MIN_POSITIVE),
+            by_regime,
+            aic,
+            bic,
+            delta_aic: aic - base_aic,
+            delta_bic: bic - base_bic,
+            evaluations: out.evaluations,
+        });
+        if best_records.is_none() {
+            best_records = Some((c.name().to_string(), out.misfit.records));
+        }
+        // Transfer 1: the late stage of every curve, held out of both fits.
+        if let Some(base_late) = holdout_base {
+            say(&format!("{}: fit without the late stage, predict it", c.name()));
+            let jac_early = out.jacobian.as_ref().map(|j| select_rows(j, &early_rows));
+            let t = refit_on(&early, &base, &space, *c, &params, &out.v, jac_early).and_then(|o| {
+                let m = extended(&late, &base, &space, *c, &params);
+                Ok(m(&o.v)?.rss())
+            });
+            res.transfer.push(match t {
+                Ok(e) => Transfer {
+                    withheld: "late stage of each curve".into(),
+                    readings: late.len(),
+                    base_chi2: base_late,
+                    effect_chi2: Some(e),
+                    shrinkage: Some(1.0 - e / base_late.max(f64::MIN_POSITIVE)),
+                    note: None,
+                },
+                Err(e) => Transfer {
+                    withheld: "late stage of each curve".into(),
+                    readings: late.len(),
+                    base_chi2: base_late,
+                    effect_chi2: None,
+                    shrinkage: None,
+                    note: Some(format!("the refit without the late stage failed: {e}")),
+                },
+            });
+        }
+        // Transfer 2: other tests, predicted with the parameters calibrated here.
+        for (name, g, setup, sub, idx, base_chi) in &withheld_base {
+            let note = if !c.transferable() {
+                Some("specimen-specific effect: its value does not carry over to another test".to_string())
+            } else if !c.applies(setup) {
+                Some("does not apply to the withheld test's model".to_string())
+            } else {
+                None
+            };
+            let mut tr = Transfer {
+                withheld: name.clone(),
+                readings: g.len(),
+                base_chi2: *base_chi,
+                effect_chi2: None,
+                shrinkage: None,
+                note: note.clone(),
+            };
+            if note.is_none() {
+                let xs: Vec<f64> = idx.iter().map(|&j| xv[j as usize]).collect();
+                let predicted = sub.apply(setup, &xs).and_then(|s| c.apply(&s, &ev)).and_then(|s| g.evaluate(&s));
+                match predicted {
+                    Ok(m) => {
+                        tr.effect_chi2 = Some(m.rss());
+                        tr.shrinkage = Some(1.0 - m.rss() / base_chi.max(f64::MIN_POSITIVE));
+                    }
+                    Err(e) => tr.note = Some(format!("prediction failed: {e}")),
+                }
+            }
+            res.transfer.push(tr);
+        }
+    }
+
+    let candidates: Vec<CandidateResult> = results.into_iter().map(|(r, _, _)| r).collect();
+    drop(f);
+    let base_fit = BaseFit {
+        parameters,
+        chi2,
+        reduced_chi2: chi2 / dof as f64,
+        p_value: p_noise,
+        at_noise_level: p_noise > NOISE_LEVEL,
+        evaluations: fit.evaluations,
+        failures: misfit.failures.clone(),
+    };
+    let verdict = verdict(&base_fit, &by_regime, &candidates, &confusable);
+    let noise = gauge
+        .blocks
+        .iter()
+        .map(|b| NoiseReport {
+            experiment: b.experiment.clone(),
+            term: b.term.clone(),
+            sigma: b.sigma,
+            unit: if b.term == "F" { "N".into() } else { "mm".into() },
+            estimated: b.sigma_estimated,
+        })
+        .collect();
+    Ok(Diagnosis {
+        problem: problem.path.display().to_string(),
+        readings: n,
+        noise,
+        base: base_fit,
+        regimes: regs,
+        misfit: by_regime,
+        identifiability,
+        candidates,
+        skipped,
+        confusable,
+        verdict,
+        wall_seconds: clock.elapsed().as_secs_f64(),
+        base_records: misfit.records,
+        best_records,
+        base_residuals: misfit.r,
+        gauge: Some(gauge),
+    })
+}
+
+fn pct(v: f64) -> String {
+    format!("{:.0}%", 100.0 * v)
+}
+
+/// The verdict in plain words.
+pub fn verdict(
+    base: &BaseFit,
+    misfit: &[RegimeMisfit],
+    candidates: &[CandidateResult],
+    confusable: &[Confusable],
+) -> String {
+    let mut out = String::new();
+    if let Some(m) = misfit.iter().max_by(|a, b| a.share.total_cmp(&b.share)) {
+        let what = if m.term == "F" { "load" } else { "debonded length" };
+        out.push_str(&format!(
+            "The misfit sits mostly in the {} regime of {} ({} of it; {what}: {}, mean test − model {:+.3} {}).",
+            m.regime,
+            m.experiment,
+            pct(m.share),
+            m.sign,
+            m.mean,
+            m.unit
+        ));
+    }
+    let best = candidates.first().and_then(|c| c.score.as_ref().map(|s| (c, s)));
+    match best {
+        Some((c, s)) if s.significant => {
+            out.push_str(&format!(
+                " Most likely cause: {} ({}); to first order it explains {} of the misfit (score {:.1}, p = {:.1e}).",
+                c.name, c.description, pct(s.explained), s.statistic, s.p_value
+            ));
+            if let Some(r) = &c.refit {
+                out.push_str(&format!(
+                    " Adding it removes {} of the misfit (ΔBIC = {:.1}).",
+                    pct(r.shrinkage),
+                    r.delta_bic
+                ));
+            }
+            for t in &c.transfer {
+                match t.shrinkage {
+                    Some(sh) => out.push_str(&format!(" On withheld data ({}) it removes {}.", t.withheld, pct(sh))),
+                    None => out.push_str(&format!(
+                        " Withheld data ({}): {}.",
+                        t.withheld,
+                        t.note.clone().unwrap_or_default()
+                    )),
+                }
+            }
+            if let (Some(by), Some(shift)) = (&s.absorbed_by, s.absorbed_shift) {
+                out.push_str(&format!(" Without it, {by} absorbs it (adding it moves {by} by {shift:+.4e})."));
+            }
+            let twins: Vec<String> = confusable
+                .iter()
+                .filter(|p| p.a == c.name || p.b == c.name)
+                .map(|p| if p.a == c.name { p.b.clone() } else { p.a.clone() })
+                .collect();
+            if !twins.is_empty() {
+                out.push_str(&format!(" These data can hardly tell it from {}.", twins.join(", ")));
+            }
+            if !base.at_noise_level {
+                if let Some(r) = &c.refit {
+                    if r.chi2 / base.chi2.max(f64::MIN_POSITIVE) * base.reduced_chi2 > 2.0 {
+                        out.push_str(" Even with it the misfit stays well above the noise: more is missing.");
+                    }
+                }
+            }
+        }
+        _ if base.at_noise_level => out = format!(
+            "No unmodelled effect is needed at this noise level: the base model fits to χ²/dof = {:.2} and no candidate scores significantly.",
+            base.reduced_chi2
+        ),
+        Some((c, s)) => out.push_str(&format!(
+            " The misfit exceeds the noise (χ²/dof = {:.1}) but no candidate explains a significant part of it; the best, {}, explains {}.",
+            base.reduced_chi2, c.name, pct(s.explained)
+        )),
+        None => out.push_str(" No candidate effect could be scored."),
+    }
+    out
+}
