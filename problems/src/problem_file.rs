@@ -204,7 +204,7 @@ impl LoadedProblem {
 
     /// Reads a problem file with some values replaced, e.g. `("law.strength_n", "20")` or
     /// `("models.dcb.effects.large_rotation", "true")`: paths as in `[[parameter]]` (`law.*`,
-    /// `models.<experiment>.*`), plus `objective.*` and `optimizer.*`. Values are TOML
+    /// `models.<experiment>.*`), plus `objective.*`, `optimizer.*` and `optimizers.<label>.*`. Values are TOML
     /// (numbers, booleans, quoted strings).
     pub fn read_with(path: &Path, overrides: &[(String, String)]) -> Result<Self> {
         let shown = path.display().to_string();
@@ -314,6 +314,13 @@ fn set_path(doc: &mut toml::Table, key: &str, value: toml::Value) -> std::result
             let head = parts.remove(0);
             doc.get_mut(head).and_then(|v| v.as_table_mut()).ok_or(format!("the file has no [{head}] table"))?
         }
+        Some("optimizers") => {
+            parts.remove(0);
+            doc.entry("optimizers")
+                .or_insert_with(|| toml::Value::Table(Default::default()))
+                .as_table_mut()
+                .ok_or("`optimizers` is not a table of named optimizers".to_string())?
+        }
         Some("models") if parts.len() > 2 => {
             let name = parts[1].to_string();
             parts.drain(..2);
@@ -334,7 +341,11 @@ fn set_path(doc: &mut toml::Table, key: &str, value: toml::Value) -> std::result
                 .ok_or(format!("no experiment named `{name}`"))?;
             entry.get_mut("model").and_then(|v| v.as_table_mut()).ok_or("the experiment has no model table")?
         }
-        _ => return Err("paths start with law., models.<experiment>., objective. or optimizer.".into()),
+        _ => {
+            return Err(
+                "paths start with law., models.<experiment>., objective., optimizer. or optimizers.<label>.".into()
+            )
+        }
     };
     let last = parts.pop().ok_or("incomplete path")?;
     for p in parts {
