@@ -19,7 +19,8 @@ use std::time::Instant;
 /// Command-line overrides and run options.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
-    /// Optimizer name instead of the file's (its settings then take their defaults).
+    /// Optimizer instead of the file's: a label of `[optimizers.<label>]` or a registered name (see
+    /// [`crate::problem_file::ProblemFile::optimizer_named`]).
     pub optimizer: Option<String>,
     /// Seed instead of the file's.
     pub seed: Option<u64>,
