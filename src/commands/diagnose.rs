@@ -89,6 +89,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<(), CzError> {
         noise: NoiseLevels { load: args.noise_load, length: args.noise_length },
         withheld,
         holdout: !args.no_holdout,
+        always_refit: Vec::new(),
         progress: Some(Box::new(move |m: &str| eprintln!("[{:6.1} s] {m}", clock.elapsed().as_secs_f64()))),
     };
     let d = diagnose::diagnose(&problem, &library, &opts)?;

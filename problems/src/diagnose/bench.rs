@@ -1,1 +1,391 @@
-//! Planted-effect cases (placeholder, filled below).
+//! `gap-bench`: the diagnosis checked on cases whose answer is known.
+//!
+//! Each planted case is a synthetic DCB test (Hartlen's specimen geometry, a triangular law, a
+//! random modulus, strength and toughness, random load and crack-length noise) made with one
+//! candidate effect switched on at a random realistic size, then diagnosed with the base model,
+//! which does not know it. Null cases have no effect. The answer of a case is the best-scoring
+//! candidate when it is significant, else "none".
+
+use crate::data::Experiment;
+use crate::diagnose::candidate::Library;
+use crate::diagnose::run::{diagnose_subject, Options, Subject};
+use crate::diagnose::stats::chi2_survival;
+use crate::identification::Setup;
+use crate::synthetic::{synthesize, Noise};
+use czid_core::{CohesiveLaw, Curve, CzError, ForwardModel, Parameter, ParameterSpace, Result};
+use czid_models::dcb::Dcb;
+use czid_models::laws::Bilinear;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Label of a case with no effect, and of a diagnosis that names none.
+pub const NONE: &str = "none";
+/// Readings per synthetic curve.
+const READINGS: usize = 120;
+/// Final opening of the synthetic tests (mm).
+const OPENING: f64 = 30.0;
+/// Mean cosine (beyond the fitted parameters) above which a pair of effects is predicted to be
+/// confusable.
+pub const CONFUSABLE: f64 = 0.9;
+
+/// Benchmark settings.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// Planted cases per effect.
+    pub cases: usize,
+    /// Null cases (no effect).
+    pub nulls: usize,
+    /// Seed of the whole benchmark (cases are reproducible one by one).
+    pub seed: u64,
+    /// Effects to plant (empty: every bundled one).
+    pub effects: Vec<String>,
+}
+
+/// A planted effect at a realistic size: `(values per parameter)` drawn for the candidate.
+fn plant(name: &str, rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
+    let sign = |rng: &mut ChaCha8Rng| if rng.random::<bool>() { 1.0 } else { -1.0 };
+    Some(match name {
+        // Bridging tails of 0.3–1.5 MPa over 0.5–2 mm openings: 0.1–1.5 N/mm of extra toughness.
+        "fibre_bridging" => vec![rng.random_range(0.3..1.5), rng.random_range(0.5..2.0)],
+        "large_rotation" => vec![1.0],
+        // 0.5–2 × h/(2 E22) for the specimen's arms (2.2e-4 mm/MPa).
+        "root_compliance" => vec![rng.random_range(1.1e-4..4.4e-4)],
+        // 2–8 mm/kN: a light load train, 5–20 % of the specimen's initial compliance.
+        "machine_compliance" => vec![rng.random_range(2e-3..8e-3)],
+        "crack_length_offset" => vec![sign(rng) * rng.random_range(1.0..4.0)],
+        "displacement_offset" => vec![sign(rng) * rng.random_range(0.2..0.8)],
+        // An effective G13 between 1/(1/G13 + 2e-4) and 1/(1/G13 + 8e-4): 30–65 % of nominal.
+        "shear_compliance" => vec![rng.random_range(2e-4..8e-4)],
+        _ => return None,
+    })
+}
+
+/// One case's outcome.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseResult {
+    /// Case index.
+    pub index: usize,
+    /// Planted effect ([`NONE`] for a null case).
+    pub planted: String,
+    /// Its values (physical units, per parameter).
+    pub size: Vec<f64>,
+    /// True strength (MPa), toughness (N/mm), modulus (MPa).
+    pub truth: [f64; 3],
+    /// Load (N) and crack-length (mm) noise.
+    pub noise: [f64; 2],
+    /// Diagnosed effect ([`NONE`] when no candidate is significant).
+    pub diagnosed: String,
+    /// Candidates by score, best first, with whether they are significant.
+    pub ranking: Vec<(String, f64, bool)>,
+    /// χ²/dof of the base fit.
+    pub base_reduced_chi2: f64,
+    /// χ²/dof with the true effect refitted.
+    pub true_reduced_chi2: Option<f64>,
+    /// Whether the refit with the true effect is at the noise level.
+    pub true_at_noise_level: Option<bool>,
+    /// The true effect's values found by the refit.
+    pub true_refit: Vec<f64>,
+    /// Candidates that could not be scored or refitted, with the reason.
+    pub notes: Vec<String>,
+    /// Cosines between candidates (beyond the fitted parameters) at this case's base fit.
+    pub pairs: Vec<(String, String, f64)>,
+    /// Effect sizes drawn again because the planted model did not run to the end.
+    pub redraws: usize,
+    /// Wall time (s).
+    pub seconds: f64,
+    /// Why the case could not be diagnosed, if so.
+    pub error: Option<String>,
+}
+
+/// The benchmark's results.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    /// Labels of the confusion matrix (planted effects, then [`NONE`]).
+    pub labels: Vec<String>,
+    /// `confusion[planted][diagnosed]` counts.
+    pub confusion: Vec<Vec<usize>>,
+    /// Top-1 accuracy per planted effect.
+    pub top1: BTreeMap<String, f64>,
+    /// Top-2 accuracy per planted effect (the planted effect among the two best significant).
+    pub top2: BTreeMap<String, f64>,
+    /// Share of null cases where an effect was named.
+    pub false_alarms: f64,
+    /// Mean cosine per pair of effects, over the cases.
+    pub mean_cos: Vec<(String, String, f64)>,
+    /// Pairs predicted confusable (mean cosine above [`CONFUSABLE`]).
+    pub confusable: Vec<(String, String, f64)>,
+    /// Effects in no confusable pair.
+    pub separable: Vec<String>,
+    /// Top-1 accuracy over the separable effects' cases.
+    pub top1_separable: f64,
+    /// Share of planted cases where refitting the true effect brings the misfit to the noise level.
+    pub true_effect_at_noise_level: f64,
+    /// Cases.
+    pub cases: Vec<CaseResult>,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+}
+
+fn base_dcb() -> Dcb {
+    let mut d = Dcb::hartlen_dcb01();
+    d.control.max_displacement = Some(OPENING);
+    d
+}
+
+/// The fitted parameters of every case: as in the real-DCB problem files.
+pub fn space() -> ParameterSpace {
+    ParameterSpace::new(vec![
+        Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),
+        Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),
+        Parameter::new("models.*.material.e11", "MPa", 10_000.0, 50_000.0),
+    ])
+    .expect("valid bounds")
+}
+
+fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult {
+    let clock = std::time::Instant::now();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
+    let truth = [rng.random_range(20.0..45.0), rng.random_range(0.5..1.2), rng.random_range(16_000.0..30_000.0)];
+    let noise = [rng.random_range(0.2..1.0), rng.random_range(0.2..0.8)];
+    let mut size = if planted == NONE { Vec::new() } else { plant(planted, &mut rng).unwrap_or_default() };
+    let jitter: Vec<f64> = (0..3).map(|_| rng.random_range(-0.05..0.05)).collect();
+    let noise_seed: u64 = rng.random();
+    let mut out = CaseResult {
+        index,
+        planted: planted.into(),
+        size: size.clone(),
+        truth,
+        noise,
+        diagnosed: NONE.into(),
+        ranking: Vec::new(),
+        base_reduced_chi2: f64::NAN,
+        true_reduced_chi2: None,
+        true_at_noise_level: None,
+        true_refit: Vec::new(),
+        notes: Vec::new(),
+        pairs: Vec::new(),
+        redraws: 0,
+        seconds: 0.0,
+        error: None,
+    };
+    let mut run = || -> Result<()> {
+        let law: Box<dyn CohesiveLaw> = Box::new(Bilinear::bk(1e5, truth[0], truth[0], truth[1], 2.0, 2.0)?);
+        let mut dcb = base_dcb();
+        dcb.material.e11 = truth[2];
+        let models: BTreeMap<String, Box<dyn ForwardModel>> =
+            [("dcb".to_string(), Box::new(dcb) as Box<dyn ForwardModel>)].into();
+        let base = Setup { law, models };
+        // A planted model that stops early is drawn again (a few times), and counted.
+        let mut attempt = 0;
+        let record = loop {
+            let true_setup = if planted == NONE {
+                base.duplicate()?
+            } else {
+                let c = library.select(&[planted.to_string()])?[0];
+                c.apply(&base, &size)?
+            };
+            match true_setup.models["dcb"].simulate(true_setup.law.as_ref()) {
+                Ok(r) => break r,
+                Err(f) if attempt < 5 && planted != NONE => {
+                    attempt += 1;
+                    out.redraws = attempt;
+                    size = plant(planted, &mut rng).unwrap_or_default();
+                    out.size = size.clone();
+                    let _ = f;
+                }
+                Err(f) => return Err(CzError::Simulation(format!("planted model: {f}"))),
+            }
+        };
+        let data = synthesize(
+            &record,
+            READINGS,
+            Some(OPENING),
+            &Noise { load_sd: noise[0], length_sd: noise[1], seed: noise_seed },
+        )?;
+        let experiment = Experiment {
+            name: "dcb".into(),
+            load: Curve::new(data.displacement.clone(), data.load)?,
+            debonded_length: Some(Curve::new(data.displacement, data.debonded_length)?),
+            initial_crack: None,
+        };
+        let space = space();
+        let u0: Vec<f64> = space.to_unit(&truth).iter().zip(&jitter).map(|(u, j)| (u + j).clamp(0.0, 1.0)).collect();
+        let subject = Subject {
+            name: format!("case {index}"),
+            setup: base,
+            space,
+            experiments: vec![experiment],
+            use_length: true,
+        };
+        let opts = Options {
+            refit: 1,
+            holdout: false,
+            always_refit: if planted == NONE { Vec::new() } else { vec![planted.to_string()] },
+            ..Options::default()
+        };
+        let d = diagnose_subject(&subject, &u0, library, &opts)?;
+        out.base_reduced_chi2 = d.base.reduced_chi2;
+        out.ranking = d
+            .candidates
+            .iter()
+            .filter_map(|c| c.score.as_ref().map(|s| (c.name.clone(), s.statistic, s.significant)))
+            .collect();
+        if let Some((name, _, true)) = out.ranking.first() {
+            out.diagnosed = name.clone();
+        }
+        if let Some(c) = d.candidates.iter().find(|c| c.name == planted) {
+            if let Some(r) = &c.refit {
+                out.true_refit = r.effect.iter().map(|v| v.value).collect();
+                let dof = d.readings.saturating_sub(r.parameters.len() + r.effect.len()).max(1) as f64;
+                out.true_reduced_chi2 = Some(r.chi2 / dof);
+                out.true_at_noise_level = Some(chi2_survival(r.chi2, dof) > 1e-3);
+            }
+        }
+        out.notes = d.candidates.iter().filter_map(|c| c.error.as_ref().map(|e| format!("{}: {e}", c.name))).collect();
+        out.pairs = d.pairs.iter().map(|p| (p.a.clone(), p.b.clone(), p.cos)).collect();
+        Ok(())
+    };
+    if let Err(e) = run() {
+        out.error = Some(e.to_string());
+    }
+    out.seconds = clock.elapsed().as_secs_f64();
+    out
+}
+
+/// Runs the benchmark; `progress(done, total)` is called as cases finish.
+pub fn run(opts: &BenchOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<BenchReport> {
+    let clock = std::time::Instant::now();
+    let library = Library::builtin();
+    let effects: Vec<String> = if opts.effects.is_empty() {
+        library.names().iter().map(|s| s.to_string()).collect()
+    } else {
+        library.select(&opts.effects)?.iter().map(|c| c.name().to_string()).collect()
+    };
+    if opts.cases == 0 && opts.nulls == 0 {
+        return Err(CzError::config("gap-bench", "no cases: give --cases and/or --nulls of at least 1"));
+    }
+    let mut plan: Vec<String> = effects.iter().flat_map(|e| std::iter::repeat_n(e.clone(), opts.cases)).collect();
+    plan.extend(std::iter::repeat_n(NONE.to_string(), opts.nulls));
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let total = plan.len();
+    let cases: Vec<CaseResult> = plan
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let r = case(i, p, opts.seed, &library);
+            progress(done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1, total);
+            r
+        })
+        .collect();
+
+    let mut labels = effects.clone();
+    labels.push(NONE.into());
+    let at = |l: &str| labels.iter().position(|x| x == l).unwrap_or(labels.len() - 1);
+    let mut confusion = vec![vec![0usize; labels.len()]; labels.len()];
+    for c in &cases {
+        confusion[at(&c.planted)][at(&c.diagnosed)] += 1;
+    }
+    let mut top1 = BTreeMap::new();
+    let mut top2 = BTreeMap::new();
+    for e in &effects {
+        let mine: Vec<&CaseResult> = cases.iter().filter(|c| &c.planted == e).collect();
+        let m = mine.len().max(1) as f64;
+        top1.insert(e.clone(), mine.iter().filter(|c| &c.diagnosed == e).count() as f64 / m);
+        let in2 = |c: &CaseResult| c.ranking.iter().filter(|r| r.2).take(2).any(|r| &r.0 == e);
+        top2.insert(e.clone(), mine.iter().filter(|c| in2(c)).count() as f64 / m);
+    }
+    let nulls: Vec<&CaseResult> = cases.iter().filter(|c| c.planted == NONE).collect();
+    let false_alarms = nulls.iter().filter(|c| c.diagnosed != NONE).count() as f64 / nulls.len().max(1) as f64;
+    let mut sums: BTreeMap<(String, String), (f64, usize)> = BTreeMap::new();
+    for c in &cases {
+        for (a, b, cos) in &c.pairs {
+            let key = if a < b { (a.clone(), b.clone()) } else { (b.clone(), a.clone()) };
+            let e = sums.entry(key).or_insert((0.0, 0));
+            e.0 += cos;
+            e.1 += 1;
+        }
+    }
+    let mean_cos: Vec<(String, String, f64)> = sums.into_iter().map(|((a, b), (s, n))| (a, b, s / n as f64)).collect();
+    let confusable: Vec<(String, String, f64)> = mean_cos.iter().filter(|p| p.2 > CONFUSABLE).cloned().collect();
+    let separable: Vec<String> =
+        effects.iter().filter(|e| !confusable.iter().any(|p| &p.0 == *e || &p.1 == *e)).cloned().collect();
+    let sep_cases: Vec<&CaseResult> = cases.iter().filter(|c| separable.contains(&c.planted)).collect();
+    let top1_separable =
+        sep_cases.iter().filter(|c| c.diagnosed == c.planted).count() as f64 / sep_cases.len().max(1) as f64;
+    let planted: Vec<&CaseResult> = cases.iter().filter(|c| c.planted != NONE).collect();
+    let true_effect_at_noise_level =
+        planted.iter().filter(|c| c.true_at_noise_level == Some(true)).count() as f64 / planted.len().max(1) as f64;
+    Ok(BenchReport {
+        labels,
+        confusion,
+        top1,
+        top2,
+        false_alarms,
+        mean_cos,
+        confusable,
+        separable,
+        top1_separable,
+        true_effect_at_noise_level,
+        cases,
+        wall_seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+/// The report in Markdown.
+pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# gap-bench: {} planted cases per effect, {} null cases, seed {}\n",
+        opts.cases, opts.nulls, opts.seed
+    );
+    let _ = writeln!(s, "Confusion matrix (rows: planted, columns: diagnosed):\n");
+    let _ = writeln!(s, "| planted \\ diagnosed | {} |", r.labels.join(" | "));
+    let _ = writeln!(s, "|---|{}", "---|".repeat(r.labels.len()));
+    for (l, row) in r.labels.iter().zip(&r.confusion) {
+        let cells: Vec<String> = row.iter().map(|c| c.to_string()).collect();
+        let _ = writeln!(s, "| {l} | {} |", cells.join(" | "));
+    }
+    let _ = writeln!(s, "\n| effect | top-1 | top-2 | true effect at noise level |\n|---|---|---|---|");
+    for (e, t1) in &r.top1 {
+        let mine: Vec<&CaseResult> = r.cases.iter().filter(|c| &c.planted == e).collect();
+        let at = mine.iter().filter(|c| c.true_at_noise_level == Some(true)).count();
+        let _ = writeln!(s, "| {e} | {:.0}% | {:.0}% | {at}/{} |", 100.0 * t1, 100.0 * r.top2[e], mine.len());
+    }
+    let _ = writeln!(s, "\nFalse alarms on null cases: {:.0}%.", 100.0 * r.false_alarms);
+    let _ = writeln!(
+        s,
+        "Top-1 accuracy over the separable effects ({}): {:.0}%.",
+        r.separable.join(", "),
+        100.0 * r.top1_separable
+    );
+    let _ = writeln!(
+        s,
+        "Refitting the true effect brings the misfit to the noise level in {:.0}% of the planted cases.\n",
+        100.0 * r.true_effect_at_noise_level
+    );
+    let _ = writeln!(s, "Confusable pairs predicted by the Jacobian angles (mean cosine > {CONFUSABLE}):\n");
+    if r.confusable.is_empty() {
+        let _ = writeln!(s, "* none");
+    }
+    for (a, b, c) in &r.confusable {
+        let _ = writeln!(s, "* {a} and {b}: {c:.3}");
+    }
+    let _ = writeln!(s, "\nMean cosines of every pair:\n\n| a | b | mean cos |\n|---|---|---|");
+    for (a, b, c) in &r.mean_cos {
+        let _ = writeln!(s, "| {a} | {b} | {c:.3} |");
+    }
+    let errors: Vec<&CaseResult> = r.cases.iter().filter(|c| c.error.is_some()).collect();
+    if !errors.is_empty() {
+        let _ = writeln!(s, "\n{} cases could not be diagnosed:\n", errors.len());
+        for c in errors {
+            let _ = writeln!(s, "* case {} ({}): {}", c.index, c.planted, c.error.clone().unwrap_or_default());
+        }
+    }
+    let _ = writeln!(s, "\nWall time {:.0} s.", r.wall_seconds);
+    s
+}

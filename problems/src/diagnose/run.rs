@@ -36,6 +36,8 @@ pub struct Options {
     pub withheld: Vec<LoadedProblem>,
     /// Also check transfer to the held-out late stage of each curve.
     pub holdout: bool,
+    /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
+    pub always_refit: Vec<String>,
     /// Called with a short message as each stage starts (e.g. for a progress display).
     pub progress: Option<Box<dyn Fn(&str) + Sync>>,
 }
@@ -49,6 +51,7 @@ impl Default for Options {
             noise: NoiseLevels::default(),
             withheld: Vec::new(),
             holdout: true,
+            always_refit: Vec::new(),
             progress: None,
         }
     }
@@ -235,6 +238,8 @@ pub struct Diagnosis {
     pub skipped: Vec<(String, String)>,
     /// Pairs of candidates the data cannot tell apart.
     pub confusable: Vec<Confusable>,
+    /// Every pair's cosine (beyond the fitted parameters' span).
+    pub pairs: Vec<Confusable>,
     /// Plain-words verdict.
     pub verdict: String,
     /// Wall time (s).
@@ -312,7 +317,8 @@ fn refit_on(
     let f = |v: &[f64]| Ok(model(v)?.r);
     // A switch stays on; only the fitted parameters move.
     let fixed: Vec<usize> = if c.discrete() { (space.dim()..start.len()).collect() } else { Vec::new() };
-    let res = lsq::minimize_from(&f, start, &fixed, &REFIT, jacobian)?;
+    let opts = if c.discrete() { &REFIT_SWITCH } else { &REFIT };
+    let res = lsq::minimize_from(&f, start, &fixed, opts, jacobian)?;
     let misfit = model(&res.u)?;
     Ok(RefitOutcome { v: res.u, misfit, evaluations: res.evaluations, jacobian: res.jacobian })
 }
@@ -320,30 +326,43 @@ fn refit_on(
 /// Refits start from the sensitivities of the scores and follow them with Broyden updates: one
 /// run per step (a large-rotation run costs ~50 small-rotation ones), one fresh finite-difference
 /// Jacobian if they stall.
-const REFIT: LsOptions = LsOptions { max_iterations: 15, step: 2e-3, tolerance: 1e-6, fd_jacobians: 1 };
+const REFIT: LsOptions = LsOptions { max_iterations: 40, step: 2e-3, tolerance: 1e-6, fd_jacobians: 3 };
+/// A switched-on effect only moves the fitted parameters, whose Jacobian barely changes with it;
+/// its runs can be far dearer (large rotations), so fewer iterations and one fresh Jacobian.
+const REFIT_SWITCH: LsOptions = LsOptions { max_iterations: 10, step: 2e-3, tolerance: 1e-4, fd_jacobians: 1 };
 
 fn select_rows(m: &DMatrix<f64>, rows: &[usize]) -> DMatrix<f64> {
     DMatrix::from_fn(rows.len(), m.ncols(), |i, j| m[(rows[i], j)])
 }
 
+/// What is diagnosed, independent of files: a setup, the fitted parameters and the data.
+pub struct Subject {
+    /// Shown in reports.
+    pub name: String,
+    /// The base setup (initial values).
+    pub setup: Setup,
+    /// The fitted parameters.
+    pub space: ParameterSpace,
+    /// The data.
+    pub experiments: Vec<crate::data::Experiment>,
+    /// Compare debonded lengths too (when measured).
+    pub use_length: bool,
+}
+
 /// Diagnoses `problem` with the candidates of `library`.
 pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> Result<Diagnosis> {
-    let clock = Instant::now();
     let say = |m: &str| {
         if let Some(p) = &opts.progress {
             p(m)
         }
     };
-    let chosen = library.select(&opts.candidates)?;
+    library.select(&opts.candidates)?;
     let id = problem.identification()?;
     let space = id.space().clone();
-    let base = id.setup().duplicate()?;
-    let gauge = Gauge::new(&problem.experiments, problem.file.objective.debonded_length, opts.noise)?;
-    let n = gauge.len();
     let p = space.dim();
-
-    // 1. Base fit: the file's optimizer (unless a result is given), then a polish on the misfit in
-    //    noise units, which is what every statistic below assumes.
+    let clock = Instant::now();
+    // Base fit: the file's optimizer unless a result is given; the polish follows in
+    // `diagnose_subject`.
     let u0 = match &opts.start {
         Some(x) => {
             if x.len() != p {
@@ -368,9 +387,35 @@ pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> R
             run.result.best_x
         }
     };
+    let subject = Subject {
+        name: problem.path.display().to_string(),
+        setup: id.setup().duplicate()?,
+        space,
+        experiments: problem.experiments.clone(),
+        use_length: problem.file.objective.debonded_length,
+    };
+    let mut d = diagnose_subject(&subject, &u0, library, opts)?;
+    d.wall_seconds = clock.elapsed().as_secs_f64();
+    Ok(d)
+}
+
+/// Diagnoses `subject` from the unit-cube point `u0` of its parameters (polished first).
+pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: &Options) -> Result<Diagnosis> {
+    let clock = Instant::now();
+    let say = |m: &str| {
+        if let Some(p) = &opts.progress {
+            p(m)
+        }
+    };
+    let chosen = library.select(&opts.candidates)?;
+    let space = subject.space.clone();
+    let base = subject.setup.duplicate()?;
+    let gauge = Gauge::new(&subject.experiments, subject.use_length, opts.noise)?;
+    let n = gauge.len();
+    let p = space.dim();
     say("polishing the base fit on the misfit in noise units");
     let f = base_residuals(&gauge, &base, &space);
-    let fit = lsq::minimize(&f, &u0, &[], &LsOptions::default())?;
+    let fit = lsq::minimize(&f, u0, &[], &LsOptions::default())?;
     let u = fit.u.clone();
     let x = space.from_unit(&u);
     let fitted = space.apply(&base, &x)?;
@@ -451,17 +496,16 @@ pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> R
         let s = |r: &CandidateResult| r.score.as_ref().map_or(-1.0, |s| s.statistic);
         s(&b.0).total_cmp(&s(&a.0))
     });
-    let mut confusable = Vec::new();
+    let mut pairs = Vec::new();
     for i in 0..results.len() {
         for j in i + 1..results.len() {
             if let (Some(a), Some(b)) = (&results[i].1, &results[j].1) {
                 let cos = score::confusability(&lin, a, b);
-                if cos > CONFUSABLE {
-                    confusable.push(Confusable { a: a.name.clone(), b: b.name.clone(), cos });
-                }
+                pairs.push(Confusable { a: a.name.clone(), b: b.name.clone(), cos });
             }
         }
     }
+    let confusable: Vec<Confusable> = pairs.iter().filter(|c| c.cos > CONFUSABLE).cloned().collect();
 
     // 5. How far: refits and transfer.
     let (base_aic, base_bic) = aic_bic(chi2, n, p);
@@ -505,10 +549,15 @@ pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> R
         .collect::<Result<_>>()?;
 
     let mut best_records = None;
-    let top: Vec<usize> = (0..results.len())
-        .filter(|&i| results[i].0.score.as_ref().is_some_and(|s| s.dof > 0))
-        .take(opts.refit)
+    let scored: Vec<usize> =
+        (0..results.len()).filter(|&i| results[i].0.score.as_ref().is_some_and(|s| s.dof > 0)).collect();
+    let mut top: Vec<usize> = scored.iter().copied().take(opts.refit).collect();
+    let extra: Vec<usize> = scored
+        .iter()
+        .copied()
+        .filter(|&i| !top.contains(&i) && opts.always_refit.contains(&results[i].0.name))
         .collect();
+    top.extend(extra);
     for &i in &top {
         let (res, sens, c) = &mut results[i];
         let sens = sens.as_ref().expect("scored candidates have a sensitivity");
@@ -670,7 +719,7 @@ pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> R
         })
         .collect();
     Ok(Diagnosis {
-        problem: problem.path.display().to_string(),
+        problem: subject.name.clone(),
         readings: n,
         noise,
         base: base_fit,
@@ -680,6 +729,7 @@ pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> R
         candidates,
         skipped,
         confusable,
+        pairs,
         verdict,
         wall_seconds: clock.elapsed().as_secs_f64(),
         base_records: misfit.records,
