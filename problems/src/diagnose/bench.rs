@@ -145,6 +145,17 @@ pub fn space() -> ParameterSpace {
     .expect("valid bounds")
 }
 
+/// The benchmark's base model: Hartlen's DCB with a triangular law of strength `truth[0]` (MPa)
+/// and toughness `truth[1]` (N/mm), arms of modulus `truth[2]` (MPa).
+fn base_setup(truth: &[f64; 3]) -> Result<Setup> {
+    let law: Box<dyn CohesiveLaw> = Box::new(Bilinear::bk(1e5, truth[0], truth[0], truth[1], 2.0, 2.0)?);
+    let mut dcb = base_dcb();
+    dcb.material.e11 = truth[2];
+    let models: BTreeMap<String, Box<dyn ForwardModel>> =
+        [("dcb".to_string(), Box::new(dcb) as Box<dyn ForwardModel>)].into();
+    Ok(Setup { law, models })
+}
+
 fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult {
     let clock = std::time::Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
@@ -172,12 +183,7 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         error: None,
     };
     let mut run = || -> Result<()> {
-        let law: Box<dyn CohesiveLaw> = Box::new(Bilinear::bk(1e5, truth[0], truth[0], truth[1], 2.0, 2.0)?);
-        let mut dcb = base_dcb();
-        dcb.material.e11 = truth[2];
-        let models: BTreeMap<String, Box<dyn ForwardModel>> =
-            [("dcb".to_string(), Box::new(dcb) as Box<dyn ForwardModel>)].into();
-        let base = Setup { law, models };
+        let base = base_setup(&truth)?;
         // A planted model that stops early is drawn again (a few times), and counted.
         let mut attempt = 0;
         let record = loop {
@@ -259,10 +265,26 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
 pub fn run(opts: &BenchOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<BenchReport> {
     let clock = std::time::Instant::now();
     let library = Library::builtin();
+    // Every candidate that applies to the benchmark's DCB and that it knows how to plant.
+    let sample = base_setup(&[30.0, 0.8, 20_000.0])?;
+    let known = |name: &str| plant(name, &mut ChaCha8Rng::seed_from_u64(0)).is_some();
     let effects: Vec<String> = if opts.effects.is_empty() {
-        library.names().iter().map(|s| s.to_string()).collect()
+        library
+            .all()
+            .into_iter()
+            .filter(|c| c.applies(&sample) && known(c.name()))
+            .map(|c| c.name().to_string())
+            .collect()
     } else {
-        library.select(&opts.effects)?.iter().map(|c| c.name().to_string()).collect()
+        for c in library.select(&opts.effects)? {
+            if !c.applies(&sample) || !known(c.name()) {
+                return Err(CzError::config(
+                    "--effects",
+                    format!("`{}` cannot be planted in the benchmark's DCB", c.name()),
+                ));
+            }
+        }
+        opts.effects.clone()
     };
     if opts.cases == 0 && opts.nulls == 0 {
         return Err(CzError::config("gap-bench", "no cases: give --cases and/or --nulls of at least 1"));

@@ -148,9 +148,10 @@ impl CandidateEffect for ModelField {
         labels
             .into_iter()
             .map(|path| {
-                let mut parameter = Parameter::new(&path, &self.unit, self.lower, self.upper);
-                parameter.path = path;
-                Ok(EffectParameter { parameter, null: self.null })
+                Ok(EffectParameter {
+                    parameter: Parameter::new(&path, &self.unit, self.lower, self.upper),
+                    null: self.null,
+                })
             })
             .collect()
     }
@@ -346,8 +347,9 @@ impl Library {
         Library { candidates: Vec::new() }
     }
 
-    /// The bundled candidates for beam tests (DCB, ENF). Ranges are realistic for coupon-size
-    /// specimens (arms of 1–5 mm, cracks of 20–100 mm).
+    /// The bundled candidates: for the DCB and ENF (ranges realistic for coupon-size specimens,
+    /// arms of 1–5 mm, cracks of 20–100 mm) and for the FRP-strengthened beam (`frp_beam`,
+    /// laboratory beams with bonded plates). Each applies only to its models.
     pub fn builtin() -> Self {
         let beams = ["dcb", "enf"];
         let mut lib = Library::empty();
@@ -404,6 +406,70 @@ impl Library {
             "1/MPa",
             [0.0, 1e-3],
         ));
+        // The FRP-strengthened beam: one table entry per switchable effect of the model.
+        let frp = ["frp_beam"];
+        let entries: [(&str, &str, &str, &str, [f64; 2], bool); 7] = [
+            (
+                "adhesive_compliance",
+                "shear compliance of the adhesive layer in series with the bond law",
+                "effects.adhesive_shear_compliance",
+                "mm/MPa",
+                [0.0, 2e-3],
+                false,
+            ),
+            (
+                "adhesive_normal_compliance",
+                "normal (peeling) compliance of the adhesive layer",
+                "effects.adhesive_normal_compliance",
+                "mm/MPa",
+                [0.0, 1e-3],
+                false,
+            ),
+            (
+                "shrinkage_strain",
+                "concrete shrinkage (or swelling) after bonding, prestressing the bond",
+                "effects.shrinkage_strain",
+                "-",
+                [-4e-4, 2e-4],
+                false,
+            ),
+            (
+                "steel_hardening",
+                "a different hardening modulus of the bars after yield",
+                "effects.steel_hardening_offset",
+                "MPa",
+                [-1500.0, 3000.0],
+                false,
+            ),
+            (
+                "concrete_softening",
+                "more or less tension softening of the cracked concrete (fracture energy)",
+                "effects.fracture_energy_offset",
+                "N/mm",
+                [-0.05, 0.1],
+                false,
+            ),
+            (
+                "concrete_cracking",
+                "earlier or later cracking (concrete tensile strength)",
+                "effects.tensile_strength_offset",
+                "MPa",
+                [-1.0, 1.0],
+                false,
+            ),
+            (
+                "deflection_offset",
+                "seating of the supports (a toe of the load–deflection curve)",
+                "effects.deflection_offset",
+                "mm",
+                [0.0, 2.0],
+                true,
+            ),
+        ];
+        for (name, description, field, unit, range, per_experiment) in entries {
+            let c = ModelField::shared(name, description, &frp, field, unit, range);
+            lib.add(if per_experiment { c.per_experiment() } else { c });
+        }
         lib
     }
 

@@ -1,0 +1,185 @@
+//! The diagnosis of the sim-to-real gap: candidate effects are the base model at their null
+//! values, a planted effect is found and a clean case is left alone, regimes split where a hand
+//! analysis of the curve puts them.
+
+use czid_core::{CohesiveLaw, Curve, ForwardModel, Parameter, ParameterSpace};
+use czid_models::dcb::Dcb;
+use czid_models::laws::Bilinear;
+use czid_problems::data::Experiment;
+use czid_problems::diagnose::regimes::{self, NAMES};
+use czid_problems::diagnose::run::{diagnose_subject, Subject};
+use czid_problems::diagnose::{CandidateEffect, Library, Options};
+use czid_problems::identification::Setup;
+use czid_problems::synthetic::{synthesize, Noise};
+use std::collections::BTreeMap;
+
+fn dcb_setup(opening: f64, points: usize) -> Setup {
+    let mut d = Dcb::hartlen_dcb01();
+    d.control.max_displacement = Some(opening);
+    d.control.output_points = points;
+    let law: Box<dyn CohesiveLaw> = Box::new(Bilinear::bk(1e5, 30.0, 30.0, 0.8, 2.0, 2.0).unwrap());
+    let models: BTreeMap<String, Box<dyn ForwardModel>> =
+        [("dcb".to_string(), Box::new(d) as Box<dyn ForwardModel>)].into();
+    Setup { law, models }
+}
+
+fn nulls(c: &dyn CandidateEffect, s: &Setup) -> Vec<f64> {
+    c.parameters(s).unwrap().iter().map(|p| p.null).collect()
+}
+
+#[test]
+fn every_bundled_dcb_candidate_at_its_null_value_is_the_base_model_exactly() {
+    let base = dcb_setup(6.0, 12);
+    let reference = base.models["dcb"].simulate(base.law.as_ref()).unwrap();
+    let library = Library::builtin();
+    let mut checked = Vec::new();
+    for c in library.all() {
+        if !c.applies(&base) {
+            continue;
+        }
+        let s = c.apply(&base, &nulls(c, &base)).unwrap();
+        assert_eq!(serde_json::to_value(&s).unwrap(), serde_json::to_value(&base).unwrap(), "{}", c.name());
+        let record = s.models["dcb"].simulate(s.law.as_ref()).unwrap();
+        assert_eq!(record, reference, "{}", c.name());
+        // And the effect does something away from its null value.
+        let params = c.parameters(&base).unwrap();
+        let on: Vec<f64> = params
+            .iter()
+            .map(|p| if p.null == p.parameter.lower { p.parameter.upper } else { p.parameter.lower })
+            .collect();
+        let s = c.apply(&base, &on).unwrap();
+        let record = s.models["dcb"].simulate(s.law.as_ref()).unwrap();
+        assert_ne!(record, reference, "{} has no effect", c.name());
+        checked.push(c.name().to_string());
+    }
+    assert_eq!(
+        checked,
+        [
+            "fibre_bridging",
+            "large_rotation",
+            "root_compliance",
+            "machine_compliance",
+            "crack_length_offset",
+            "displacement_offset",
+            "shear_compliance"
+        ]
+    );
+}
+
+#[test]
+fn the_beam_candidates_apply_to_the_frp_beam_only_and_are_null_there() {
+    let beam = czid_models::frp::beam::FrpBeam::paper().unwrap();
+    let law: Box<dyn CohesiveLaw> = Box::new(Bilinear::bk(1e5, 5.0, 5.0, 0.5, 1.0, 2.0).unwrap());
+    let models: BTreeMap<String, Box<dyn ForwardModel>> =
+        [("beam".to_string(), Box::new(beam) as Box<dyn ForwardModel>)].into();
+    let setup = Setup { law, models };
+    let library = Library::builtin();
+    let applies: Vec<&str> = library.all().into_iter().filter(|c| c.applies(&setup)).map(|c| c.name()).collect();
+    // Bridging applies to any setup with a bilinear law; the rest are the beam's own.
+    assert!(applies.len() >= 4, "{applies:?}");
+    for name in ["adhesive_compliance", "shrinkage_strain", "steel_hardening", "concrete_softening"] {
+        assert!(applies.contains(&name), "{name} missing from {applies:?}");
+        let c = library.select(&[name.to_string()]).unwrap()[0];
+        let s = c.apply(&setup, &nulls(c, &setup)).unwrap();
+        assert_eq!(serde_json::to_value(&s).unwrap(), serde_json::to_value(&setup).unwrap(), "{name}");
+        assert!(!c.applies(&dcb_setup(5.0, 5)), "{name} applies to a DCB");
+    }
+}
+
+#[test]
+fn an_unknown_candidate_is_named_with_the_known_ones() {
+    let err = Library::builtin().select(&["warp_drive".to_string()]).err().unwrap().to_string();
+    assert!(err.contains("unknown candidate `warp_drive`") && err.contains("machine_compliance"), "{err}");
+}
+
+#[test]
+fn regimes_split_where_the_hand_analysis_puts_them() {
+    // Linear to 4 mm (10 N/mm), a softer rise to the 45 N peak at 5 mm, then a fall of 10 N/mm.
+    let x: Vec<f64> = (0..=800).map(|i| i as f64 * 0.01).collect();
+    let p: Vec<f64> = x
+        .iter()
+        .map(|&v| {
+            if v <= 4.0 {
+                10.0 * v
+            } else if v <= 5.0 {
+                40.0 + 5.0 * (v - 4.0)
+            } else {
+                45.0 - 10.0 * (v - 5.0)
+            }
+        })
+        .collect();
+    let r = regimes::split("t", &x, &p);
+    let names: Vec<&str> = r.iter().map(|g| g.name.as_str()).collect();
+    assert_eq!(names, NAMES);
+    // Secant 95 % of 10 N/mm: (20 + 5x)/x < 9.5 from x > 4.444; 95 % of the peak: x > 5.225;
+    // the late stage is the last third of [5.23, 8].
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    assert!(close(r[0].to, 4.45), "{:?}", r[0]);
+    assert!(close(r[1].to, 5.23), "{:?}", r[1]);
+    assert!(close(r[2].to, 5.23 + 2.0 / 3.0 * (8.0 - 5.23)), "{:?}", r[2]);
+    assert!(close(r[3].to, 8.0), "{:?}", r[3]);
+    // A curve that never falls from its peak has no propagation.
+    let rising = regimes::split("t", &x[..500], &p[..500]);
+    assert_eq!(rising.iter().map(|g| g.name.as_str()).collect::<Vec<_>>(), NAMES[..2]);
+}
+
+/// A synthetic test of the DCB with a bridging tail of `bridging` MPa (0: none), diagnosed with
+/// the base model from a start 5 % of the ranges away from the truth.
+fn diagnose_synthetic(bridging: f64) -> czid_problems::diagnose::Diagnosis {
+    let base = dcb_setup(16.0, 60);
+    let library = Library::builtin();
+    let truth = if bridging > 0.0 {
+        library.select(&["fibre_bridging".to_string()]).unwrap()[0].apply(&base, &[bridging, 1.0]).unwrap()
+    } else {
+        base.duplicate().unwrap()
+    };
+    let record = truth.models["dcb"].simulate(truth.law.as_ref()).unwrap();
+    let data = synthesize(&record, 80, Some(16.0), &Noise { load_sd: 0.4, length_sd: 0.3, seed: 11 }).unwrap();
+    let experiment = Experiment {
+        name: "dcb".into(),
+        load: Curve::new(data.displacement.clone(), data.load).unwrap(),
+        debonded_length: Some(Curve::new(data.displacement, data.debonded_length).unwrap()),
+        initial_crack: None,
+    };
+    let space = ParameterSpace::new(vec![
+        Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),
+        Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),
+        Parameter::new("models.*.material.e11", "MPa", 10_000.0, 50_000.0),
+    ])
+    .unwrap();
+    let u0: Vec<f64> =
+        space.to_unit(&[30.0, 0.8, 19_300.0]).iter().zip([0.05, -0.05, 0.05]).map(|(u, d)| u + d).collect();
+    let subject =
+        Subject { name: "synthetic".into(), setup: base, space, experiments: vec![experiment], use_length: true };
+    let opts = Options {
+        candidates: ["machine_compliance", "fibre_bridging", "crack_length_offset", "displacement_offset"]
+            .map(String::from)
+            .to_vec(),
+        refit: 1,
+        holdout: false,
+        ..Options::default()
+    };
+    diagnose_subject(&subject, &u0, &library, &opts).unwrap()
+}
+
+#[test]
+fn a_planted_bridging_tail_ranks_first_and_its_refit_reaches_the_noise() {
+    let d = diagnose_synthetic(1.0);
+    let best = &d.candidates[0];
+    let score = best.score.as_ref().unwrap();
+    assert_eq!(best.name, "fibre_bridging", "{}", d.verdict);
+    assert!(score.significant);
+    assert!(!d.base.at_noise_level, "{}", d.base.reduced_chi2);
+    let refit = best.refit.as_ref().unwrap();
+    let dof = (d.readings - 5) as f64;
+    assert!(czid_problems::diagnose::stats::chi2_survival(refit.chi2, dof) > 1e-3, "{} / {dof}", refit.chi2);
+    assert!(d.verdict.contains("Most likely cause: fibre_bridging"), "{}", d.verdict);
+}
+
+#[test]
+fn a_clean_test_needs_no_unmodelled_effect() {
+    let d = diagnose_synthetic(0.0);
+    assert!(d.base.at_noise_level, "{}", d.base.reduced_chi2);
+    assert!(d.candidates.iter().all(|c| !c.score.as_ref().unwrap().significant), "{}", d.verdict);
+    assert!(d.verdict.starts_with("No unmodelled effect is needed at this noise level"), "{}", d.verdict);
+}
