@@ -80,6 +80,25 @@ impl FibreMaterial {
         }
     }
 
+    /// Stiffness of unloading from `stress` at `strain` (MPa): elastic for the steels, the secant
+    /// `σ/ε` for the concretes (they unload to the origin).
+    #[inline]
+    pub fn unloading_stiffness(&self, strain: f64, stress: f64) -> f64 {
+        match self {
+            FibreMaterial::Steel(s) => s.elastic_modulus,
+            FibreMaterial::CrackSteel { steel, ratio } => steel.elastic_modulus * ratio,
+            FibreMaterial::Concrete(_)
+            | FibreMaterial::UncrackedConcrete(_)
+            | FibreMaterial::CrackedConcrete { .. } => {
+                if strain.abs() > 1e-12 {
+                    (stress / strain).max(0.0)
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
     /// Recoverable energy per unit volume at `strain` with stress `stress` (MPa = N·mm/mm³).
     #[inline]
     pub fn stored_energy(&self, strain: f64, stress: f64) -> f64 {
@@ -145,7 +164,9 @@ impl FibreSection {
     /// Section forces and tangent at `e` from the committed `states` (one per fibre); the trial
     /// states and stresses go to `trial` and `stress`. With `secant`, each fibre contributes its
     /// secant stiffness `σ/ε` (non-negative for these materials under monotonic loading) instead
-    /// of its tangent: an iteration matrix that cannot cycle between loading and unloading.
+    /// of its tangent: an iteration matrix that cannot cycle between loading and unloading. A
+    /// fibre `k` with `unloading[k]` set contributes its unloading stiffness
+    /// ([`FibreMaterial::unloading_stiffness`]) instead.
     pub fn respond(
         &self,
         e: [f64; 2],
@@ -153,15 +174,22 @@ impl FibreSection {
         trial: &mut [UniaxialState],
         stress: &mut [f64],
         secant: bool,
+        unloading: &[bool],
     ) -> SectionResponse {
         let mut r = SectionResponse::default();
         for (k, f) in self.fibres.iter().enumerate() {
-            let res = self.materials[f.material].respond(self.strain(f, e), &states[k]);
-            // (the iteration stiffness below)
+            let mat = &self.materials[f.material];
+            let mech = self.strain(f, e);
+            let res = mat.respond(mech, &states[k]);
             trial[k] = res.state;
             stress[k] = res.stress;
-            let mech = self.strain(f, e);
-            let stiffness = if secant && mech.abs() > 1e-12 { (res.stress / mech).max(0.0) } else { res.tangent };
+            let stiffness = if unloading.get(k).copied().unwrap_or(false) {
+                mat.unloading_stiffness(mech, res.stress)
+            } else if secant && mech.abs() > 1e-12 {
+                (res.stress / mech).max(0.0)
+            } else {
+                res.tangent
+            };
             let (fa, ka) = (res.stress * f.area, stiffness * f.area);
             r.force[0] += fa;
             r.force[1] -= fa * f.z;

@@ -13,6 +13,19 @@
 //! `f_int(q) = P e`, `a·q = c` by Newton's method (Crisfield's indirect displacement control):
 //! `K x₁ = −r`, `K x₂ = e`, `ΔP = (c − a·q − a·x₁)/(a·x₂)`, `Δq = x₁ + ΔP x₂`.
 //!
+//! **Extrapolated damage.** When several softening stretches of the interface (both sides of
+//! every crack of a plated beam) load at once, the path branches: some go on softening, the others
+//! unload, and with the law's own tangent Newton's method cycles between such choices without
+//! converging. With [`DamageUpdate::Extrapolated`] each step holds the interface's damage at its
+//! value extrapolated from the last two states (Oliver, Huespe & Cante's implicit–explicit
+//! integration), so that within a step the interface is linear with a positive stiffness and the
+//! step has a unique solution; the law then updates the damage from the step's gaps, and the step
+//! is repeated smaller while the two differ by more than a tolerance. The error is of the order of
+//! the step and is measured by halving it (the book's FRP beam chapter). The normal status of a
+//! damaged point (open, `(1 − D) k_n`; closed, `k_n`) is also taken from the start of the step
+//! and corrected at most twice per step (`Solver::correct_status`). Energies are those of the
+//! tractions in equilibrium (trapezoidal rule on each point's gap, `½ T·g` recoverable).
+//!
 //! **Interface in series with a compliance.** Each cohesive point may carry a linear compliance
 //! `C = diag(c_n, c_t)` (mm/MPa) in series with the law (an adhesive layer): the law sees the gap
 //! `g_l` solving `g_l + C T(g_l) = g` (a local Newton solve per point), and the point's stiffness
@@ -90,6 +103,31 @@ pub struct ControlPath {
     pub damage_threshold: f64,
     /// Newton settings.
     pub newton: NewtonSettings,
+    /// How the interface's damage enters the equilibrium of a step.
+    pub damage_update: DamageUpdate,
+}
+
+/// How the interface's damage enters the equilibrium of a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DamageUpdate {
+    /// The law's own response (damage from the gaps of the step itself): exact, but Newton's
+    /// method has to find which of many softening points load and which unload.
+    Implicit,
+    /// Damage extrapolated from the last two converged states (implicit–explicit integration,
+    /// Oliver, Huespe & Cante 2008): within a step each point is linear with the damage
+    /// `D_ex = D_n + (Δc/Δc_n)(D_n − D_{n−1})` (clamped to `[D_n, 1]`), so the step's problem
+    /// has a positive interface stiffness and a unique solution; after convergence the law
+    /// updates the damage from the step's gaps. The step is repeated at half the size while
+    /// `max |D_{n+1} − D_ex|` exceeds `tolerance`, down to `min_fraction` of the output spacing
+    /// (there the step is taken: the path crosses an unstable stretch at nearly fixed control,
+    /// as a test under that control would). Needs a law that unloads along its secant,
+    /// `T = (1 − D) K ⟨g⟩` (checked).
+    Extrapolated {
+        /// Largest accepted difference between the updated and the extrapolated damage.
+        tolerance: f64,
+        /// Smallest step, as a fraction of the output spacing.
+        min_fraction: f64,
+    },
 }
 
 /// One recorded state.
@@ -195,6 +233,18 @@ struct Solver<'a> {
     with_compliance: bool,
     /// Secant iterations after a correction that increased the residual.
     secant_iterations: usize,
+    /// Extrapolated damage of each point in this step (`None`: the law's own response).
+    extrapolated: Option<Vec<f64>>,
+    /// The law's initial stiffness `[k_n, k_t]` (MPa/mm).
+    k0: [f64; 2],
+    /// Per fibre in the current step: whether it was loading (history changed) at the last
+    /// assembly, how often that has changed, and whether it now takes its unloading stiffness.
+    fibre_loading: Vec<bool>,
+    fibre_flips: Vec<u8>,
+    fibre_unloading: Vec<bool>,
+    /// Per interface point in the current step, with extrapolated damage: whether it is taken as
+    /// open (`g_n > 0`) or closed (see `correct_status`).
+    open: Vec<bool>,
 }
 
 #[inline]
@@ -346,6 +396,12 @@ impl<'a> Solver<'a> {
             stats: NonlinearStats::default(),
             with_compliance: p.compliance != [0.0, 0.0],
             secant_iterations: 4,
+            extrapolated: None,
+            k0: law.initial_stiffness(),
+            fibre_loading: vec![false; nfib],
+            fibre_flips: vec![0; nfib],
+            fibre_unloading: vec![false; nfib],
+            open: vec![false; np],
         }
     }
 
@@ -372,7 +428,20 @@ impl<'a> Solver<'a> {
                 &mut self.trial.fibres[range.clone()],
                 &mut self.trial.stresses[range.clone()],
                 secant,
+                &self.fibre_unloading[range.clone()],
             );
+            // A fibre that keeps switching between loading and unloading from one iteration to
+            // the next (a bar at yield, concrete at its envelope) sits on its loading surface in
+            // the solution, where Newton's tangents on either side send it across: its unloading
+            // stiffness, stiffer than its tangent, makes the iterations contract there.
+            for k in range.clone() {
+                let loading = self.trial.fibres[k] != c.fibres[k];
+                if loading != self.fibre_loading[k] {
+                    self.fibre_loading[k] = loading;
+                    self.fibre_flips[k] = self.fibre_flips[k].saturating_add(1);
+                    self.fibre_unloading[k] = self.fibre_flips[k] >= 3;
+                }
+            }
             for (k, fib) in sec.fibres.iter().enumerate() {
                 self.trial.strains[fe.first + k] = sec.strain(fib, e);
             }
@@ -390,7 +459,10 @@ impl<'a> Solver<'a> {
             let kin = interface::kinematics(&p.mesh, pt, q, false, &mut hess);
             let gap = Gap::new(kin.gap[0], kin.gap[1]);
             let state = &c.points[ip];
-            let (ev, d, gl) = if self.with_compliance {
+            let (ev, d, gl) = if let Some(dex) = &self.extrapolated {
+                // Open or closed as at the start of the step (see `correct_status`).
+                self.with_damage(&gap, state, dex[ip], self.open[ip])
+            } else if self.with_compliance {
                 match self.series(&gap, state, c.law_gaps[ip], secant) {
                     Some(v) => v,
                     None => return false,
@@ -438,6 +510,53 @@ impl<'a> Solver<'a> {
         ok
     }
 
+    /// A point with the fixed damage `dex` (secant `(1 − D) K` in slip and opening, `K` in
+    /// closure), in series with the compliance: its traction and stiffness, with the state the law
+    /// reaches at the same law gap (the implicit update, committed after convergence).
+    /// `open` selects the normal branch (see `correct_status`).
+    fn with_damage(&self, gap: &Gap, state: &LawState, dex: f64, open: bool) -> (LawEval, Tangent, Gap) {
+        let c = self.p.compliance;
+        let intact = 1.0 - dex;
+        let series = |k: f64, c: f64| k / (1.0 + c * k);
+        let kn = series(if open { intact * self.k0[0] } else { self.k0[0] }, c[0]);
+        let kt = series(intact * self.k0[1], c[1]);
+        let t = Traction::new(kn * gap[0], kt * gap[1]);
+        let gl = Gap::new(gap[0] - c[0] * t[0], gap[1] - c[1] * t[1]);
+        let d = Tangent::new(kn, 0.0, 0.0, kt);
+        let updated = self.law.evaluate(&gl, state).state;
+        (LawEval { traction: t, tangent: d, state: updated }, d, gl)
+    }
+
+    /// Corrects the normal status (open or closed) of the points whose converged state contradicts
+    /// it by a force above the tolerance `tol`; `true` if any was corrected.
+    ///
+    /// With extrapolated damage a damaged point's normal stiffness is `(1 − D) k_n` open and `k_n`
+    /// closed: a kink at zero opening, where a debonded plate lying on the soffit has many points.
+    /// Newton's method cycles between contact states there, so the status of every point is taken
+    /// from the start of the step and held through the iterations (the step's problem is then
+    /// smooth in the interface); a converged state that contradicts it is corrected and solved
+    /// again (an active-set iteration).
+    fn correct_status(&mut self, tol: f64) -> bool {
+        let Some(dex) = &self.extrapolated else {
+            return false;
+        };
+        let mut any = false;
+        for (ip, pt) in self.p.points.iter().enumerate() {
+            let g = self.trial.gaps[ip][0];
+            let open = self.open[ip];
+            if open == (g > 0.0) {
+                continue;
+            }
+            // Force the wrong branch puts on the point: its stiffness difference times the gap.
+            let error = pt.area * pt.factor * dex[ip] * self.k0[0] * g.abs();
+            if error > tol {
+                self.open[ip] = !open;
+                any = true;
+            }
+        }
+        any
+    }
+
     /// The law behind the series compliance: solves `g_l + C T(g_l) = g` from the guess `g0`;
     /// returns the law's evaluation at `g_l`, the point's iteration stiffness `D (I + C D)⁻¹` and
     /// `g_l`.
@@ -482,6 +601,11 @@ impl<'a> Solver<'a> {
         // flipping between loading and unloading from one iteration to the next): a correction
         // that increased the residual is halved, and the next iterations use secant stiffnesses (a
         // fixed-point iteration that settles the active set) before Newton resumes.
+        self.open.iter_mut().zip(&c.gaps).for_each(|(o, g)| *o = g[0] > 0.0);
+        let mut releases = 0usize;
+        self.fibre_loading.iter_mut().for_each(|v| *v = false);
+        self.fibre_flips.iter_mut().for_each(|v| *v = 0);
+        self.fibre_unloading.iter_mut().for_each(|v| *v = false);
         let mut r_prev = f64::INFINITY;
         let mut alpha = 1.0f64;
         let mut secant_left = 0usize;
@@ -504,15 +628,32 @@ impl<'a> Solver<'a> {
             let ctl: f64 = self.p.control.iter().map(|&(d, a)| a * q[d]).sum();
             let cres = c_target.map_or(0.0, |t| t - ctl);
             if rmax <= tol && cres.abs() <= 1e-12 * ctl.abs().max(1e-9) {
-                return Some(it);
+                // At most two corrections of the normal statuses per step: beyond, a debonded
+                // plate lying on the soffit keeps switching points between touching and lifting by
+                // fractions of a micrometre; the statuses then stay as they are for this step
+                // (explicit, like the damage) and are taken from the converged gaps for the next.
+                if releases >= 2 || !self.correct_status(tol) {
+                    return Some(it);
+                }
+                // A new start for the iterations with the corrected statuses.
+                releases += 1;
+                r_prev = f64::INFINITY;
+                it = 0;
+                continue;
             }
-            if rmax > r_prev && alpha > 0.3 {
+            // With extrapolated damage the interface is linear within a step; what is left are the
+            // kinks of the fibres (a bar at yield, cracked concrete at zero strain): a
+            // backtracking line search on the correction (down to 1/32 of it) instead of the
+            // secant iterations.
+            let (min_alpha, secant_after) =
+                if self.extrapolated.is_some() { (1.0 / 32.0, 0) } else { (0.3, self.secant_iterations) };
+            if rmax > r_prev && alpha > min_alpha {
                 alpha *= 0.5;
                 for (qi, di) in q.iter_mut().zip(&dq) {
                     *qi -= alpha * di;
                 }
                 *load -= alpha * dload;
-                secant_left = self.secant_iterations;
+                secant_left = secant_after;
                 it += 1;
                 continue;
             }
@@ -591,6 +732,21 @@ pub fn run(
     if !(path.spacing > 0.0 && path.max_control > 0.0 && path.spacing.is_finite() && path.max_control.is_finite()) {
         return Err(fail(Vec::new(), "the control path needs a positive spacing and end".into()));
     }
+    let explicit = match path.damage_update {
+        DamageUpdate::Implicit => None,
+        DamageUpdate::Extrapolated { tolerance, min_fraction } => {
+            if !(tolerance > 0.0 && min_fraction > 0.0 && min_fraction <= 1.0) {
+                return Err(fail(
+                    Vec::new(),
+                    "extrapolated damage needs a positive tolerance and a step fraction in (0, 1]".into(),
+                ));
+            }
+            if let Err(msg) = check_secant_unloading(law) {
+                return Err(fail(Vec::new(), msg));
+            }
+            Some((tolerance, min_fraction))
+        }
+    };
     let mut s = Solver::new(p, law, path.newton);
     let n = p.mesh.n_dofs();
     let mut committed = s.trial.clone();
@@ -629,8 +785,14 @@ pub fn run(
         let mut int = 0.0;
         for (ip, pt) in p.points.iter().enumerate() {
             let t = h.tractions[ip];
-            let adhesive = 0.5 * (c[0] * t[0] * t[0] + c[1] * t[1] * t[1]);
-            int += pt.area * pt.factor * (law.stored_energy(&h.law_gaps[ip], &h.points[ip]) + adhesive);
+            int += pt.area
+                * pt.factor
+                * if explicit.is_some() {
+                    // Linear within the step, law and compliance together: ½ T·g.
+                    0.5 * t.dot(&h.gaps[ip])
+                } else {
+                    law.stored_energy(&h.law_gaps[ip], &h.points[ip]) + 0.5 * (c[0] * t[0] * t[0] + c[1] * t[1] * t[1])
+                };
         }
         (lin + fib + int, int, fib)
     };
@@ -693,6 +855,11 @@ pub fn run(
     let mut prev_load = load;
     let mut h_prev = 0.0f64;
     let mut trial_q = vec![0.0; n];
+    let np = p.points.len();
+    // Damage of the points at the last two committed states, for the extrapolation.
+    let mut d_prev = vec![0.0; np];
+    let mut d_ex = vec![0.0; np];
+    let mut failed = 0usize;
     let max_steps = 200 * ((target / spacing).ceil() as usize) + 20_000;
     while pos < target - eps {
         if s.stats.steps > max_steps {
@@ -705,7 +872,33 @@ pub fn run(
             trial_q[i] = q[i] + alpha * (q[i] - prev_q[i]);
         }
         let mut trial_load = load + alpha * (load - prev_load);
-        match s.solve(&committed, &mut trial_q, &mut trial_load, Some(c0 + pos + dh)) {
+        if explicit.is_some() {
+            for (ip, d) in d_ex.iter_mut().enumerate() {
+                let dn = committed.points[ip].damage;
+                *d = (dn + alpha * (dn - d_prev[ip])).clamp(dn, 1.0);
+            }
+            s.extrapolated = Some(std::mem::take(&mut d_ex));
+        }
+        let solved = s.solve(&committed, &mut trial_q, &mut trial_load, Some(c0 + pos + dh));
+        if let Some(v) = s.extrapolated.take() {
+            d_ex = v;
+        }
+        // With extrapolated damage: how far the law's update departs from the damage used.
+        let departure = match (solved, explicit) {
+            (Some(_), Some(_)) => {
+                s.trial.points.iter().zip(&d_ex).map(|(st, d)| (st.damage - d).abs()).fold(0.0, f64::max)
+            }
+            _ => 0.0,
+        };
+        if let (Some(_), Some((tolerance, min_fraction))) = (solved, explicit) {
+            let floor = (spacing * min_fraction).max(h_min);
+            if departure > tolerance && dh > floor * (1.0 + 1e-9) {
+                s.stats.cuts += 1;
+                h = (0.5 * dh).max(floor);
+                continue;
+            }
+        }
+        match solved {
             Some(it) => {
                 // Energies of the step, point by point.
                 let d_old = displacement(&q);
@@ -713,18 +906,27 @@ pub fn run(
                 totals.external += 0.5 * (load + trial_load) * (d_new - d_old);
                 let c = p.compliance;
                 for (ip, pt) in p.points.iter().enumerate() {
-                    let (g0, t0) = (committed.law_gaps[ip], committed.tractions[ip]);
-                    let (g1, t1) = (s.trial.law_gaps[ip], s.trial.tractions[ip]);
-                    let before = &committed.points[ip];
-                    let after = &s.trial.points[ip];
-                    let mut w = if after != before {
-                        path_work(law, before, (g0, t0), (g1, t1), after, None)
-                    } else {
+                    let w = if explicit.is_some() {
+                        // Linear within the step: the trapezoidal rule on the total gap.
+                        let (g0, t0) = (committed.gaps[ip], committed.tractions[ip]);
+                        let (g1, t1) = (s.trial.gaps[ip], s.trial.tractions[ip]);
                         0.5 * (t0 + t1).dot(&(g1 - g0))
+                    } else {
+                        let (g0, t0) = (committed.law_gaps[ip], committed.tractions[ip]);
+                        let (g1, t1) = (s.trial.law_gaps[ip], s.trial.tractions[ip]);
+                        let before = &committed.points[ip];
+                        let after = &s.trial.points[ip];
+                        let mut w = if after != before {
+                            path_work(law, before, (g0, t0), (g1, t1), after, None)
+                        } else {
+                            0.5 * (t0 + t1).dot(&(g1 - g0))
+                        };
+                        if s.with_compliance {
+                            w +=
+                                0.5 * (c[0] * (t1[0] * t1[0] - t0[0] * t0[0]) + c[1] * (t1[1] * t1[1] - t0[1] * t0[1]));
+                        }
+                        w
                     };
-                    if s.with_compliance {
-                        w += 0.5 * (c[0] * (t1[0] * t1[0] - t0[0] * t0[0]) + c[1] * (t1[1] * t1[1] - t0[1] * t0[1]));
-                    }
                     totals.interface_work += pt.area * pt.factor * w;
                 }
                 for fe in &s.fibre_elements {
@@ -740,6 +942,9 @@ pub fn run(
                         totals.material_work += f.area * fe.len * w;
                     }
                 }
+                for (d, st) in d_prev.iter_mut().zip(&committed.points) {
+                    *d = st.damage;
+                }
                 prev_q.copy_from_slice(&q);
                 prev_load = load;
                 q.copy_from_slice(&trial_q);
@@ -748,14 +953,22 @@ pub fn run(
                 s.stats.steps += 1;
                 pos += dh;
                 h_prev = dh;
-                if it <= 4 {
+                let easy = explicit.is_none_or(|(tolerance, _)| departure <= 0.25 * tolerance);
+                if it <= 4 && easy {
                     h = (2.0 * h).min(spacing);
                 } else if it >= 8 {
                     h = (0.5 * h).max(h_min);
                 }
-                if (next - pos).abs() <= eps {
+                // States are recorded on the output grid and, in between, whenever another point
+                // has failed (the debonding front's progress through a load drop).
+                let now_failed = committed.points.iter().filter(|st| st.damage >= path.damage_threshold).count();
+                let on_grid = (next - pos).abs() <= eps;
+                if on_grid {
                     pos = next;
                     k_out += 1;
+                }
+                if on_grid || now_failed != failed {
+                    failed = now_failed;
                     if record(&s, &committed, &q, load, &totals, &mut rows, observe) {
                         break;
                     }
@@ -776,4 +989,29 @@ pub fn run(
     }
     s.stats.assemblies = s.stats.assemblies.max(1);
     Ok((rows, s.stats))
+}
+
+/// Checks that `law` unloads along its secant, `T = (1 − D) K ⟨g⟩` with its initial stiffness
+/// `K` (what [`DamageUpdate::Extrapolated`] assumes), at a few damaged mixed-mode states.
+fn check_secant_unloading(law: &dyn CohesiveLaw) -> Result<(), String> {
+    let [kn, kt] = law.initial_stiffness();
+    let [sn, st] = strengths(law);
+    let init = law.initial_state();
+    for (a, b) in [(1.5, 0.0), (0.0, 1.5), (1.2, 1.2), (0.0, 3.0), (-1.0, 2.0)] {
+        let g = Gap::new(a * sn / kn, b * st / kt);
+        let ev = law.evaluate(&g, &init);
+        let intact = 1.0 - ev.state.damage;
+        let expected = Traction::new(if g[0] > 0.0 { intact * kn } else { kn } * g[0], intact * kt * g[1]);
+        let back = law.evaluate(&(g * 0.5), &ev.state);
+        let unloaded = expected * 0.5;
+        let scale = expected.norm().max(1e-9 * (sn + st));
+        if (ev.traction - expected).norm() > 1e-6 * scale || (back.traction - unloaded).norm() > 1e-6 * scale {
+            return Err(format!(
+                "extrapolated damage needs a law that unloads along its secant T = (1 − D) K g; this one does not \
+                 (at the gap ({:.4e}, {:.4e}) mm)",
+                g[0], g[1]
+            ));
+        }
+    }
+    Ok(())
 }

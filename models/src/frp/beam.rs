@@ -41,7 +41,18 @@
 //!   as cracks open, bars yield and the plate debonds, so the run follows the load drops of
 //!   debonding (and any snap-back in the deflection) that a test under displacement control jumps
 //!   over.
-//! * **Run end**: complete debonding of the modelled side (every interface point failed),
+//! * **Interface damage extrapolated within a step** ([`DamageUpdate::Extrapolated`], tolerance
+//!   `control.damage_tolerance`): both sides of every crack soften at once, and with the law's
+//!   own tangent Newton's method cannot settle which of them go on softening and which unload.
+//!   With the damage held at its extrapolated value each step has a unique solution; the law
+//!   updates the damage after it, and steps are halved (down to `control.min_step_fraction` of
+//!   the output step) while the two differ by more than the tolerance. Where no state with a
+//!   larger elongation is near (the debonded zone running to the plate end), steps of the
+//!   smallest size cross the unstable stretch at nearly fixed elongation, as a test controlled by
+//!   that elongation would jump. States are recorded every `control.elongation_step` and whenever
+//!   another interface point fails.
+//! * **Run end**: complete debonding of the modelled side (the failed stretch of the interface
+//!   that ends at the plate end reaches back to where debonding started),
 //!   crushing of the concrete (top fibre strain beyond `ε_cu` anywhere), or
 //!   `control.max_elongation`, whichever comes first ([`RunEnd`]).
 //!
@@ -68,7 +79,7 @@ use super::section::RcSection;
 use super::spec::FrpBeamSpec;
 use crate::fe::fibre::{Fibre, FibreMaterial, FibreSection};
 use crate::fe::mesh::{graded, NONE};
-use crate::fe::nonlinear::{self, ControlPath, FibreLayer, NonlinearProblem, NonlinearStats, Snapshot};
+use crate::fe::nonlinear::{self, ControlPath, DamageUpdate, FibreLayer, NonlinearProblem, NonlinearStats, Snapshot};
 use crate::fe::{InterfacePoint, Layer, Mesh, NewtonSettings, PointKind, Section, Spring};
 use crate::laws::StCzm;
 
@@ -130,6 +141,14 @@ pub struct BeamControl {
     pub max_iterations: usize,
     /// Relative residual tolerance.
     pub tolerance: f64,
+    /// Largest difference between the interface damage the law gives at the end of a step and
+    /// the damage extrapolated for it ([`DamageUpdate::Extrapolated`]); a step that exceeds it is
+    /// repeated at half the size.
+    pub damage_tolerance: f64,
+    /// Smallest step, as a fraction of `elongation_step`, to which a step is halved for the damage
+    /// tolerance (a step of that size is taken whatever the difference: an unstable stretch of the
+    /// path, crossed at nearly fixed elongation).
+    pub min_step_fraction: f64,
 }
 
 impl Default for BeamControl {
@@ -140,6 +159,8 @@ impl Default for BeamControl {
             damage_threshold: 1.0 - 1e-9,
             max_iterations: 25,
             tolerance: 1e-9,
+            damage_tolerance: 0.05,
+            min_step_fraction: 1.0 / 64.0,
         }
     }
 }
@@ -176,7 +197,8 @@ pub struct FrpBeam {
 /// Why a run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RunEnd {
-    /// Every interface point of the modelled side has failed.
+    /// The failed stretch of the interface that ends at the plate end reaches back to where
+    /// debonding started: the plate is debonded from the first failed crack mouth to its end.
     CompleteDebonding,
     /// The concrete's top fibre passed its crushing strain.
     ConcreteCrushing,
@@ -350,6 +372,15 @@ impl FrpBeam {
             return Err(CzError::invalid(OWNER, "control.max_iterations", 0.0, "must be at least 1"));
         }
         require_positive(OWNER, "control.tolerance", c.tolerance)?;
+        require_positive(OWNER, "control.damage_tolerance", c.damage_tolerance)?;
+        if !(c.min_step_fraction > 0.0 && c.min_step_fraction <= 1.0) {
+            return Err(CzError::invalid(
+                OWNER,
+                "control.min_step_fraction",
+                c.min_step_fraction,
+                "must lie in (0, 1]",
+            ));
+        }
         self.effects.validate(OWNER)?;
         // The effects must leave valid materials.
         self.materials().map(|_| ())
@@ -528,6 +559,10 @@ impl FrpBeam {
             min_step_fraction: 1e-4,
             damage_threshold: c.damage_threshold,
             newton: NewtonSettings { max_iterations: c.max_iterations, tolerance: c.tolerance },
+            damage_update: DamageUpdate::Extrapolated {
+                tolerance: c.damage_tolerance,
+                min_fraction: c.min_step_fraction,
+            },
         };
         let eps_cu = self.section.concrete.crushing_strain;
         let z_top = 0.5 * self.section.height;
@@ -554,9 +589,16 @@ impl FrpBeam {
             if profiles {
                 kept.push(profile(&p, s, row));
             }
-            if failed.len() == p.points.len() {
-                end = RunEnd::CompleteDebonding;
-                return true;
+            // Complete debonding: the failed stretch that ends at the plate end reaches back to
+            // where debonding started (IC debonding has run through to the plate end; the plate
+            // beyond the first debonded crack carries nothing).
+            let from_end = s.point_states.iter().rev().take_while(|st| st.damage >= threshold).count();
+            if let (Some(st), true) = (start, from_end > 0) {
+                let first = p.points.len() - from_end;
+                if p.mesh.x[p.points[first].node] <= st.x.0 {
+                    end = RunEnd::CompleteDebonding;
+                    return true;
+                }
             }
             let crushed = (0..layout.support).any(|i| {
                 let (a, b) = (p.mesh.dofs(0, i), p.mesh.dofs(0, i + 1));
