@@ -1,10 +1,9 @@
 //! Gauss–Newton (argmin's `GaussNewton`) on finite-difference Jacobians of
 //! [`czid_core::Evaluation::residuals`].
 
-use super::{local_optimizer, with_restarts, Ctx, Differences, LocalOptimizer, LocalSettings};
+use super::{local_optimizer, Ctx, Differences, LocalSettings};
 use argmin::core::{Error, Executor, Jacobian, Operator};
 use argmin_math::{ArgminDot, ArgminInv, ArgminTranspose};
-use czid_core::{Budget, Observer, OptimizationResult, Problem, Result};
 use std::cell::RefCell;
 
 /// Gauss–Newton (registry name `gauss-newton`); needs a problem with residuals.
@@ -186,24 +185,14 @@ impl Jacobian for Residuals<'_, '_> {
     }
 }
 
-impl LocalOptimizer for GaussNewton {
-    fn minimize_from(
-        &self,
-        problem: &dyn Problem,
-        budget: &Budget,
-        start: &[f64],
-        observer: &mut dyn Observer,
-    ) -> Result<OptimizationResult> {
-        let ctx = Ctx::new(problem, &self.settings, budget, observer)?;
+impl GaussNewton {
+    fn polish(&self, ctx: &Ctx<'_>, z0: Vec<f64>) {
         let s = &self.settings;
-        with_restarts(&ctx, start, |z0| {
-            let Ok(solver) = argmin::solver::gaussnewton::GaussNewton::new().with_tolerance(s.tolerance) else {
-                return;
-            };
-            let op = Residuals { ctx: &ctx, last: RefCell::new(None) };
-            // Errors mean a stop, a failed evaluation or a singular JᵀJ: the best point is kept.
-            let _ = Executor::new(op, solver).configure(|st| st.param(z0).max_iters(s.max_iterations)).run();
-        });
-        ctx.finish()
+        let Ok(solver) = argmin::solver::gaussnewton::GaussNewton::new().with_tolerance(s.tolerance) else {
+            return;
+        };
+        let op = Residuals { ctx, last: RefCell::new(None) };
+        // Errors mean a stop, a failed evaluation or a singular JᵀJ: the best point is kept.
+        let _ = Executor::new(op, solver).configure(|st| st.param(z0).max_iters(s.max_iterations)).run();
     }
 }

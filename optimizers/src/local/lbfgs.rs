@@ -1,9 +1,8 @@
 //! L-BFGS (argmin's `LBFGS` with a Moré–Thuente line search) on finite-difference gradients.
 
-use super::{local_optimizer, with_restarts, Ctx, Differences, LocalOptimizer, LocalSettings};
+use super::{local_optimizer, Ctx, Differences, LocalSettings};
 use argmin::core::{CostFunction, Error, Executor, Gradient};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
-use czid_core::{Budget, Observer, OptimizationResult, Problem, Result};
 use std::cell::RefCell;
 
 /// L-BFGS (registry name `lbfgs`).
@@ -54,26 +53,16 @@ impl Gradient for Fd<'_, '_> {
     }
 }
 
-impl LocalOptimizer for Lbfgs {
-    fn minimize_from(
-        &self,
-        problem: &dyn Problem,
-        budget: &Budget,
-        start: &[f64],
-        observer: &mut dyn Observer,
-    ) -> Result<OptimizationResult> {
-        let ctx = Ctx::new(problem, &self.settings, budget, observer)?;
+impl Lbfgs {
+    fn polish(&self, ctx: &Ctx<'_>, z0: Vec<f64>) {
         let s = &self.settings;
-        with_restarts(&ctx, start, |z0| {
-            let solver = argmin::solver::quasinewton::LBFGS::new(MoreThuenteLineSearch::new(), s.memory)
-                .with_tolerance_grad(s.tolerance)
-                .and_then(|l| l.with_tolerance_cost(0.0));
-            let Ok(solver) = solver else { return };
-            let fd = Fd { ctx: &ctx, last: RefCell::new(None) };
-            // Errors mean a stop (budget, target, observer) or a failed line search: either
-            // way the best point is in the tracker.
-            let _ = Executor::new(fd, solver).configure(|st| st.param(z0).max_iters(s.max_iterations)).run();
-        });
-        ctx.finish()
+        let solver = argmin::solver::quasinewton::LBFGS::new(MoreThuenteLineSearch::new(), s.memory)
+            .with_tolerance_grad(s.tolerance)
+            .and_then(|l| l.with_tolerance_cost(0.0));
+        let Ok(solver) = solver else { return };
+        let fd = Fd { ctx, last: RefCell::new(None) };
+        // Errors mean a stop (budget, target, observer) or a failed line search: either
+        // way the best point is in the tracker.
+        let _ = Executor::new(fd, solver).configure(|st| st.param(z0).max_iters(s.max_iterations)).run();
     }
 }

@@ -3,8 +3,7 @@
 //! Tingleff, "Methods for non-linear least squares problems", 2004, Alg. 3.16).
 
 use super::gauss_newton::Residuals;
-use super::{local_optimizer, with_restarts, Ctx, LocalOptimizer, LocalSettings};
-use czid_core::{Budget, Observer, OptimizationResult, Problem, Result};
+use super::{local_optimizer, Ctx, LocalSettings};
 use std::cell::RefCell;
 
 /// Levenberg–Marquardt (registry name `levenberg-marquardt`, alias `lm`); needs residuals.
@@ -18,20 +17,10 @@ local_optimizer!(LevenbergMarquardt, "levenberg-marquardt");
 /// Initial damping relative to the largest diagonal entry of JᵀJ (Nielsen's τ).
 const TAU: f64 = 1e-3;
 
-impl LocalOptimizer for LevenbergMarquardt {
-    fn minimize_from(
-        &self,
-        problem: &dyn Problem,
-        budget: &Budget,
-        start: &[f64],
-        observer: &mut dyn Observer,
-    ) -> Result<OptimizationResult> {
-        let ctx = Ctx::new(problem, &self.settings, budget, observer)?;
-        with_restarts(&ctx, start, |z0| {
-            let op = Residuals { ctx: &ctx, last: RefCell::new(None) };
-            let _ = solve(&op, z0, self.settings.tolerance, self.settings.max_iterations);
-        });
-        ctx.finish()
+impl LevenbergMarquardt {
+    fn polish(&self, ctx: &Ctx<'_>, z0: Vec<f64>) {
+        let op = Residuals { ctx, last: RefCell::new(None) };
+        let _ = solve(&op, z0, self.settings.tolerance, self.settings.max_iterations);
     }
 }
 

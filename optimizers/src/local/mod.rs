@@ -252,7 +252,9 @@ fn start_point(settings: &LocalSettings, problem: &dyn Problem, owner: &str) -> 
     }
 }
 
-/// Implements [`Optimizer`] for a local method from its [`LocalOptimizer`] impl.
+/// Implements [`Optimizer`] and [`LocalOptimizer`] for a local method from its inherent
+/// `fn polish(&self, ctx: &Ctx<'_>, z0: Vec<f64>)`: one run from `z0` (unbounded coordinates)
+/// that evaluates through `ctx` and may stop at any evaluation `ctx` refuses.
 macro_rules! local_optimizer {
     ($ty:ty, $name:literal) => {
         impl czid_core::Optimizer for $ty {
@@ -268,7 +270,21 @@ macro_rules! local_optimizer {
                 observer: &mut dyn czid_core::Observer,
             ) -> czid_core::Result<czid_core::OptimizationResult> {
                 let start = super::start_point(&self.settings, problem, $name)?;
-                self.minimize_from(problem, budget, &start, observer)
+                super::LocalOptimizer::minimize_from(self, problem, budget, &start, observer)
+            }
+        }
+
+        impl super::LocalOptimizer for $ty {
+            fn minimize_from(
+                &self,
+                problem: &dyn czid_core::Problem,
+                budget: &czid_core::Budget,
+                start: &[f64],
+                observer: &mut dyn czid_core::Observer,
+            ) -> czid_core::Result<czid_core::OptimizationResult> {
+                let ctx = super::Ctx::new(problem, &self.settings, budget, observer)?;
+                super::with_restarts(&ctx, start, |z0| self.polish(&ctx, z0));
+                ctx.finish()
             }
         }
 

@@ -1,8 +1,7 @@
 //! Nelder–Mead simplex search (argmin's `NelderMead`), restarted from its best point.
 
-use super::{local_optimizer, with_restarts, Ctx, LocalOptimizer, LocalSettings};
+use super::{local_optimizer, Ctx, LocalSettings};
 use argmin::core::{CostFunction, Error, Executor};
-use czid_core::{Budget, Observer, OptimizationResult, Problem, Result};
 use std::cell::Cell;
 
 /// Nelder–Mead (registry name `nelder-mead`).
@@ -36,30 +35,20 @@ impl CostFunction for Cost<'_, '_> {
     }
 }
 
-impl LocalOptimizer for NelderMead {
-    fn minimize_from(
-        &self,
-        problem: &dyn Problem,
-        budget: &Budget,
-        start: &[f64],
-        observer: &mut dyn Observer,
-    ) -> Result<OptimizationResult> {
-        let ctx = Ctx::new(problem, &self.settings, budget, observer)?;
+impl NelderMead {
+    fn polish(&self, ctx: &Ctx<'_>, z0: Vec<f64>) {
         let s = &self.settings;
-        with_restarts(&ctx, start, |z0| {
-            let mut simplex = vec![z0.clone()];
-            for i in 0..ctx.dim() {
-                let mut v = z0.clone();
-                v[i] += s.initial_step;
-                simplex.push(v);
-            }
-            let Ok(solver) = argmin::solver::neldermead::NelderMead::new(simplex).with_sd_tolerance(s.tolerance) else {
-                return;
-            };
-            // An error here only means that the run was stopped (budget, target, observer).
-            let cost = Cost { ctx: &ctx, initial_vertices_left: Cell::new(ctx.dim() + 1) };
-            let _ = Executor::new(cost, solver).configure(|st| st.max_iters(s.max_iterations)).run();
-        });
-        ctx.finish()
+        let mut simplex = vec![z0.clone()];
+        for i in 0..ctx.dim() {
+            let mut v = z0.clone();
+            v[i] += s.initial_step;
+            simplex.push(v);
+        }
+        let Ok(solver) = argmin::solver::neldermead::NelderMead::new(simplex).with_sd_tolerance(s.tolerance) else {
+            return;
+        };
+        // An error here only means that the run was stopped (budget, target, observer).
+        let cost = Cost { ctx, initial_vertices_left: Cell::new(ctx.dim() + 1) };
+        let _ = Executor::new(cost, solver).configure(|st| st.max_iters(s.max_iterations)).run();
     }
 }
