@@ -4,7 +4,7 @@
 //! Regimes of a load–displacement curve (any test that loads, peaks and softens):
 //! * **initial loading**: from the start while the secant stiffness `P/δ` stays within 5 % of
 //!   its largest value before the peak (linear response; a seating toe only delays that largest
-//!   value);
+//!   value; readings below 10 % of the peak load, mostly noise, do not count);
 //! * **onset / peak**: from there until the load has fallen 5 % below its peak (damage onset,
 //!   crack initiation);
 //! * **propagation**: from there over the first two thirds of the remaining displacement range;
@@ -18,6 +18,8 @@ use serde::Serialize;
 
 /// Secant stiffness drop that ends the initial loading.
 const LINEAR_DROP: f64 = 0.05;
+/// Share of the peak load below which readings do not define the initial stiffness.
+const FIRST_LOAD: f64 = 0.1;
 /// Load drop below the peak that ends the onset/peak regime.
 const PEAK_DROP: f64 = 0.05;
 /// Share of the post-peak displacement range counted as propagation; the rest is the late stage.
@@ -47,8 +49,9 @@ pub fn split(experiment: &str, x: &[f64], p: &[f64]) -> Vec<Regime> {
     }
     let end = x[n - 1];
     let peak = (0..n).max_by(|&a, &b| p[a].total_cmp(&p[b])).unwrap_or(0);
-    // Largest secant stiffness before the peak (readings at zero displacement have none).
-    let secant = |i: usize| if x[i] > 0.0 { p[i] / x[i] } else { f64::NAN };
+    // Largest secant stiffness before the peak, over readings above 10 % of the peak load (the
+    // first readings' secants are mostly noise).
+    let secant = |i: usize| if x[i] > 0.0 && p[i] >= FIRST_LOAD * p[peak] { p[i] / x[i] } else { f64::NAN };
     let k0 = (0..=peak).map(secant).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
     let kmax_at = (0..=peak).find(|&i| secant(i) == k0).unwrap_or(0);
     let linear_end = (kmax_at..=peak).find(|&i| secant(i) < (1.0 - LINEAR_DROP) * k0).unwrap_or(peak);

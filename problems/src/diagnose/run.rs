@@ -779,7 +779,14 @@ pub fn verdict(
             }
             for t in &c.transfer {
                 match t.shrinkage {
-                    Some(sh) => out.push_str(&format!(" On withheld data ({}) it removes {}.", t.withheld, pct(sh))),
+                    Some(sh) if sh >= 0.0 => {
+                        out.push_str(&format!(" On withheld data ({}) it removes {}.", t.withheld, pct(sh)))
+                    }
+                    Some(sh) => out.push_str(&format!(
+                        " On withheld data ({}) it makes the prediction worse (misfit +{}).",
+                        t.withheld,
+                        pct(-sh)
+                    )),
                     None => out.push_str(&format!(
                         " Withheld data ({}): {}.",
                         t.withheld,
@@ -788,7 +795,13 @@ pub fn verdict(
                 }
             }
             if let (Some(by), Some(shift)) = (&s.absorbed_by, s.absorbed_shift) {
-                out.push_str(&format!(" Without it, {by} absorbs it (adding it moves {by} by {shift:+.4e})."));
+                out.push_str(&format!(" Without it, {by} absorbs it (first-order shift {shift:+.4e}"));
+                let before = base.parameters.iter().find(|q| &q.path == by);
+                let after = c.refit.as_ref().and_then(|r| r.parameters.iter().find(|q| &q.name == by));
+                if let (Some(b), Some(a)) = (before, after) {
+                    out.push_str(&format!("; the refit moves it from {:.4e} to {:.4e} {}", b.value, a.value, b.unit));
+                }
+                out.push_str(").");
             }
             let twins: Vec<String> = confusable
                 .iter()
