@@ -570,6 +570,7 @@ impl FrpBeam {
         let mut extra: Vec<[f64; 2]> = Vec::new();
         let mut end = RunEnd::MaxElongation;
         let mut start = None;
+        let mut debonded_before = false;
         let mut kept = Vec::new();
         let threshold = c.damage_threshold;
         let mut observe = |s: &Snapshot| -> bool {
@@ -592,12 +593,19 @@ impl FrpBeam {
             // Complete debonding: the failed stretch that ends at the plate end reaches back to
             // where debonding started (IC debonding has run through to the plate end; the plate
             // beyond the first debonded crack carries nothing).
+            // The run ends at the state recorded after the one where this first holds: the
+            // equilibrium of a step holds the damage extrapolated from the states before it, so
+            // the state where the last point fails still carries some of the plate's force, the
+            // next one no longer does.
             let from_end = s.point_states.iter().rev().take_while(|st| st.damage >= threshold).count();
             if let (Some(st), true) = (start, from_end > 0) {
                 let first = p.points.len() - from_end;
                 if p.mesh.x[p.points[first].node] <= st.x.0 {
-                    end = RunEnd::CompleteDebonding;
-                    return true;
+                    if debonded_before {
+                        end = RunEnd::CompleteDebonding;
+                        return true;
+                    }
+                    debonded_before = true;
                 }
             }
             let crushed = (0..layout.support).any(|i| {
