@@ -336,6 +336,10 @@ impl CandidateEffect for BridgingTail {
     }
 }
 
+/// A table entry of a [`ModelField`] candidate: name, description, field, unit, range, per
+/// experiment.
+type Entry = (&'static str, &'static str, &'static str, &'static str, [f64; 2], bool);
+
 /// The candidates a diagnosis draws from: the bundled ones plus any registered by the user.
 pub struct Library {
     candidates: Vec<Box<dyn CandidateEffect>>,
@@ -408,7 +412,7 @@ impl Library {
         ));
         // The FRP-strengthened beam: one table entry per switchable effect of the model.
         let frp = ["frp_beam"];
-        let entries: [(&str, &str, &str, &str, [f64; 2], bool); 7] = [
+        let entries: [Entry; 7] = [
             (
                 "adhesive_compliance",
                 "shear compliance of the adhesive layer in series with the bond law",

@@ -21,6 +21,9 @@ const NOISE_LEVEL: f64 = 1e-3;
 /// Cosine above which two candidates are reported as confusable.
 pub const CONFUSABLE: f64 = 0.9;
 
+/// A callback receiving a short message as each stage starts.
+pub type ProgressFn = Box<dyn Fn(&str) + Sync>;
+
 /// What to diagnose and how.
 pub struct Options {
     /// Candidates to score (names in the library; empty: every one that applies).
@@ -39,7 +42,7 @@ pub struct Options {
     /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
     pub always_refit: Vec<String>,
     /// Called with a short message as each stage starts (e.g. for a progress display).
-    pub progress: Option<Box<dyn Fn(&str) + Sync>>,
+    pub progress: Option<ProgressFn>,
 }
 
 impl Default for Options {

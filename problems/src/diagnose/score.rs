@@ -93,6 +93,9 @@ pub struct Sensitivity {
     pub discrete: bool,
 }
 
+/// One sensitivity run: parameter, unit value, residuals or why the run failed.
+type Eval = (usize, f64, std::result::Result<Vec<f64>, String>);
+
 /// The evaluation points a candidate needs for its sensitivity: `(parameter, unit value)`.
 fn points(params: &[EffectParameter], discrete: bool) -> Vec<(usize, f64)> {
     let mut out = Vec::new();
@@ -129,7 +132,8 @@ pub fn sensitivities(
         run: bool,
         setup: Option<Setup>,
     }
-    let mut prepared: Vec<std::result::Result<(Vec<EffectParameter>, Vec<Job>), String>> = Vec::new();
+    type Prepared = std::result::Result<(Vec<EffectParameter>, Vec<Job>), String>;
+    let mut prepared: Vec<Prepared> = Vec::new();
     for (ci, c) in candidates.iter().enumerate() {
         let prep = (|| -> Result<(Vec<EffectParameter>, Vec<Job>)> {
             let params = c.parameters(fitted)?;
@@ -165,7 +169,7 @@ pub fn sensitivities(
             }
         };
         let null_u: Vec<f64> = params.iter().map(|p| p.parameter.to_unit(p.null)).collect();
-        let mut evals: Vec<(usize, f64, std::result::Result<Vec<f64>, String>)> = Vec::new();
+        let mut evals: Vec<Eval> = Vec::new();
         for job in &jobs {
             debug_assert_eq!(job.candidate, ci);
             let r = match job.run {
@@ -182,8 +186,7 @@ pub fn sensitivities(
         let mut columns = DMatrix::zeros(n, params.len());
         let mut failure = None;
         for j in 0..params.len() {
-            let mine: Vec<&(usize, f64, std::result::Result<Vec<f64>, String>)> =
-                evals.iter().filter(|e| e.0 == j).collect();
+            let mine: Vec<&Eval> = evals.iter().filter(|e| e.0 == j).collect();
             let mut pts: Vec<(f64, &Vec<f64>)> = Vec::new();
             for e in &mine {
                 match &e.2 {

@@ -2,7 +2,7 @@
 
 /// `P(X > x)` for `X ~ χ²(k)`.
 pub fn chi2_survival(x: f64, k: f64) -> f64 {
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return 1.0;
     }
     gamma_q(0.5 * k, 0.5 * x)
