@@ -100,6 +100,8 @@ pub struct Figure {
     pub vlines: Vec<VLine>,
     /// Logarithmic ordinate.
     pub log_y: bool,
+    /// Names shown at the abscissae 1, 2, … instead of numbers (a categorical axis); empty: numbers.
+    pub categories: Vec<String>,
     /// Size in pixels.
     pub size: (u32, u32),
 }
@@ -125,6 +127,7 @@ impl Figure {
             series: Vec::new(),
             vlines: Vec::new(),
             log_y: false,
+            categories: Vec::new(),
             size: (900, 600),
         }
     }
@@ -138,6 +141,12 @@ impl Figure {
     /// Adds a vertical marker.
     pub fn with_vline(mut self, label: &str, x: f64) -> Self {
         self.vlines.push(VLine { label: label.into(), x });
+        self
+    }
+
+    /// Names the abscissae 1, 2, …: a categorical axis (e.g. one column of points per optimizer).
+    pub fn with_categories(mut self, names: &[String]) -> Self {
+        self.categories = names.to_vec();
         self
     }
 
@@ -207,6 +216,19 @@ impl Figure {
         }
     }
 
+    /// An abscissa tick label: the category at an integer position, else the number.
+    fn x_tick(&self, x: f64) -> String {
+        if self.categories.is_empty() {
+            return tick(x);
+        }
+        let k = x.round();
+        if (x - k).abs() < 1e-6 && k >= 1.0 && k as usize <= self.categories.len() {
+            self.categories[k as usize - 1].clone()
+        } else {
+            String::new()
+        }
+    }
+
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, plotters::coord::Shift>) -> std::result::Result<(), String>
     where
         DB::ErrorType: 'static,
@@ -222,6 +244,8 @@ impl Figure {
                 .configure_mesh()
                 .x_desc(&self.x_label)
                 .y_desc(&self.y_label)
+                .x_label_formatter(&|x| self.x_tick(*x))
+                .y_label_formatter(&|y| tick(*y))
                 .label_style(("sans-serif", 15))
                 .light_line_style(RGBColor(235, 235, 235))
                 .draw()
@@ -233,6 +257,8 @@ impl Figure {
                 .configure_mesh()
                 .x_desc(&self.x_label)
                 .y_desc(&self.y_label)
+                .x_label_formatter(&|x| self.x_tick(*x))
+                .y_label_formatter(&|y| tick(*y))
                 .label_style(("sans-serif", 15))
                 .light_line_style(RGBColor(235, 235, 235))
                 .draw()
@@ -297,9 +323,40 @@ impl Figure {
     }
 }
 
+/// A short tick label: plain digits for moderate magnitudes, scientific notation otherwise.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if (1e-2..1e5).contains(&a) {
+        let s = format!("{v:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        let s = format!("{v:.2e}");
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_are_short_and_exact() {
+        assert_eq!(super::tick(0.0), "0");
+        assert_eq!(super::tick(2.5), "2.5");
+        assert_eq!(super::tick(120.0), "120");
+        assert_eq!(super::tick(0.0125), "0.0125");
+        assert_eq!(super::tick(3e-4), "3e-4");
+        assert_eq!(super::tick(1.5e-4), "1.5e-4");
+        assert_eq!(super::tick(2.5e6), "2.5e6");
+        let f = Figure::new("t", "x", "y").with_categories(&["miga".into(), "lm".into()]);
+        assert_eq!(
+            (f.x_tick(1.0), f.x_tick(2.0), f.x_tick(1.5), f.x_tick(3.0)),
+            ("miga".into(), "lm".into(), "".into(), "".into())
+        );
+    }
 
     #[test]
     fn writes_png_and_svg_and_rejects_other_extensions() {

@@ -122,8 +122,9 @@ fn write_outputs(
     let xs: Vec<f64> = grid.iter().map(|&n| n as f64).collect();
     let mut fig = Figure::new("convergence (median, quartiles over seeds)", "evaluations", "best objective f").log_y();
     let mut finals =
-        Figure::new(&format!("final objective per run (target {:.0e})", opts.target), "optimizer", "best objective f")
-            .log_y();
+        Figure::new(&format!("final objective per run (target {})", opts.target), "optimizer", "best objective f")
+            .log_y()
+            .with_categories(&opts.optimizers);
     for (k, name) in opts.optimizers.iter().enumerate() {
         let mine: Vec<&RunSummary> = runs.iter().filter(|r| &r.optimizer == name).collect();
         let (mut med, mut lo, mut hi) = (Vec::new(), Vec::new(), Vec::new());
