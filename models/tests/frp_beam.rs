@@ -245,3 +245,29 @@ fn plate_strain_profiles_at_several_stages() {
     let at = |xq: f64| *pr.x.iter().zip(&pr.plate_strain).find(|(x, _)| (*x - xq).abs() < 1e-9).unwrap().1;
     assert!(at(370.0) > 1.5 * at(450.0), "{} {}", at(370.0), at(450.0));
 }
+
+#[test]
+fn other_crack_patterns_and_effects_also_run_to_complete_debonding() {
+    // The first crack off the symmetric pattern (no crack's two sides mirror each other), wider
+    // crack spacing, an adhesive layer in series with the law and shrinkage: each run reaches
+    // complete debonding, with the load after it below three quarters of the peak.
+    let law = FrpBeam::table8_law().unwrap();
+    let mut variants = Vec::new();
+    let mut b = FrpBeam::paper().unwrap();
+    b.cracks.first = Some(60.0);
+    variants.push(("first crack at 60 mm", b));
+    let mut b = FrpBeam::paper().unwrap();
+    b.cracks.spacing = 200.0;
+    variants.push(("cracks every 200 mm", b));
+    let mut b = FrpBeam::paper().unwrap();
+    b.effects.adhesive_shear_compliance = 6.7e-4;
+    b.effects.shrinkage_strain = -2e-4;
+    variants.push(("adhesive layer and shrinkage", b));
+    for (name, beam) in variants {
+        let run = beam.run(&law, false).unwrap_or_else(|f| panic!("{name}: {}", f.error));
+        assert_eq!(run.end, RunEnd::CompleteDebonding, "{name}");
+        let p = run.record.column(columns::LOAD).unwrap();
+        let pmax = p.iter().fold(0.0f64, |m, &v| m.max(v));
+        assert!(*p.last().unwrap() < 0.75 * pmax, "{name}: {} vs {pmax}", p.last().unwrap());
+    }
+}
