@@ -146,43 +146,65 @@ pub fn minimize_from(
         let dmax = (0..free.len()).map(|i| a[(i, i)]).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
         let m = mu.get_or_insert(1e-3 * dmax);
         let mut improved = None;
-        for _ in 0..8 {
-            let mut lhs = a.clone();
-            for i in 0..free.len() {
-                lhs[(i, i)] += *m * a[(i, i)].max(1e-9 * dmax);
-            }
-            let Some(step) = lhs.cholesky().map(|c| c.solve(&(-&g))) else {
-                *m *= 4.0;
-                continue;
+        // Two damping levels per round, run side by side (both always run, so the outcome does
+        // not depend on the number of threads); the less damped one wins when both improve.
+        'rounds: for _ in 0..4 {
+            // Coordinates on a bound that the gradient pushes outwards stay there for this step
+            // (the step of the others is solved without them).
+            let moving: Vec<usize> = (0..free.len())
+                .filter(|&k| {
+                    let v = u[free[k]];
+                    !((v <= 0.0 && g[k] > 0.0) || (v >= 1.0 && g[k] < 0.0))
+                })
+                .collect();
+            let trial_at = |damping: f64| -> Option<Vec<f64>> {
+                let q = moving.len();
+                let mut lhs = DMatrix::from_fn(q, q, |i, j| a[(moving[i], moving[j])]);
+                for i in 0..q {
+                    lhs[(i, i)] += damping * a[(moving[i], moving[i])].max(1e-9 * dmax);
+                }
+                let rhs = DVector::from_fn(q, |i, _| -g[moving[i]]);
+                let step = lhs.cholesky().map(|c| c.solve(&rhs))?;
+                let mut trial = u.clone();
+                for (c, &k) in moving.iter().enumerate() {
+                    let j = free[k];
+                    trial[j] = (u[j] + step[c]).clamp(0.0, 1.0);
+                }
+                (trial != u).then_some(trial)
             };
-            let mut trial = u.clone();
-            for (k, &j) in free.iter().enumerate() {
-                trial[j] = (u[j] + step[k]).clamp(0.0, 1.0);
-            }
-            if trial == u {
+            let levels = [*m, 4.0 * *m];
+            let trials: Vec<Option<Vec<f64>>> = levels.iter().map(|&d| trial_at(d)).collect();
+            if trials.iter().all(|t| t.is_none()) {
                 break;
             }
-            evaluations += 1;
-            let rt = f(&trial);
-            if let Ok(rt) = &rt {
-                // Broyden's update along the step actually taken (clipped at the bounds).
-                let du = DVector::from_iterator(free.len(), free.iter().map(|&j| trial[j] - u[j]));
-                let dr = DVector::from_iterator(r.len(), rt.iter().zip(&r).map(|(a, b)| a - b));
-                let d2 = du.norm_squared();
-                if d2 > 0.0 {
-                    let miss = dr - &jac * &du;
-                    jac += miss * du.transpose() / d2;
-                    fresh = false;
+            let results: Vec<Option<Result<Vec<f64>>>> = trials.par_iter().map(|t| t.as_ref().map(|t| f(t))).collect();
+            for (k, (trial, rt)) in trials.into_iter().zip(results).enumerate() {
+                let (Some(trial), Some(rt)) = (trial, rt) else { continue };
+                evaluations += 1;
+                if let Ok(rt) = &rt {
+                    // Broyden's update along the step actually taken (clipped at the bounds).
+                    let du = DVector::from_iterator(free.len(), free.iter().map(|&j| trial[j] - u[j]));
+                    let dr = DVector::from_iterator(r.len(), rt.iter().zip(&r).map(|(a, b)| a - b));
+                    let d2 = du.norm_squared();
+                    if d2 > 0.0 {
+                        let miss = dr - &jac * &du;
+                        jac += miss * du.transpose() / d2;
+                        fresh = false;
+                    }
+                }
+                if improved.is_none() {
+                    if let Ok(rt) = rt {
+                        if ss(&rt) < cost {
+                            improved = Some((trial, rt));
+                            *m = (levels[k] / 3.0).max(1e-12 * dmax);
+                        }
+                    }
                 }
             }
-            match rt {
-                Ok(rt) if ss(&rt) < cost => {
-                    improved = Some((trial, rt));
-                    *m = (*m / 3.0).max(1e-12 * dmax);
-                    break;
-                }
-                _ => *m *= 4.0,
+            if improved.is_some() {
+                break 'rounds;
             }
+            *m *= 16.0;
         }
         let Some((trial, rt)) = improved else {
             // No progress: a fresh finite-difference Jacobian, if one is left, else stop.

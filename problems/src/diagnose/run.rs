@@ -569,20 +569,33 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         let params: Vec<Parameter> = sens.parameters.iter().map(|q| q.parameter.clone()).collect();
         let null_start: Vec<f64> = u.iter().copied().chain(sens.null_u.iter().copied()).collect();
         // The joint first-order prediction: the effect at the size the data ask for, the fitted
-        // parameters moved by what they no longer have to absorb.
-        let shifted = u.iter().zip(&s.fitted_shift).map(|(a, b)| (a + b).clamp(0.0, 1.0));
-        let start: Vec<f64> = if c.discrete() {
-            shifted.chain(std::iter::repeat_n(1.0, params.len())).collect()
-        } else {
-            shifted.chain(params.iter().zip(&s.predicted).map(|(q, v)| q.to_unit(v.1).clamp(0.0, 1.0))).collect()
-        };
+        // parameters moved by what they no longer have to absorb. When the response is strongly
+        // non-linear in the effect, a fraction of that step is the better start; failing all, the
+        // null (a switch: on, with the fitted values).
         let model = extended(&gauge, &base, &space, *c, &params);
-        // The first-order size is a good start unless the response is strongly non-linear in it.
-        let start = match model(&start) {
-            Ok(m) if m.rss() <= chi2 => start,
-            _ if c.discrete() => u.iter().copied().chain(std::iter::repeat_n(1.0, params.len())).collect(),
-            _ => null_start,
+        let along = |t: f64| -> Vec<f64> {
+            let fitted = u.iter().zip(&s.fitted_shift).map(|(a, b)| (a + t * b).clamp(0.0, 1.0));
+            if c.discrete() {
+                fitted.chain(std::iter::repeat_n(1.0, params.len())).collect()
+            } else {
+                let effect = sens.null_u.iter().zip(params.iter().zip(&s.predicted)).map(|(&u0, (q, v))| {
+                    let full = q.to_unit(v.1);
+                    (u0 + t * (full - u0)).clamp(0.0, 1.0)
+                });
+                fitted.chain(effect).collect()
+            }
         };
+        let start = [1.0, 0.5, 0.25, 0.125]
+            .into_iter()
+            .map(along)
+            .find(|v| model(v).is_ok_and(|m| m.rss() <= chi2))
+            .unwrap_or_else(|| {
+                if c.discrete() {
+                    u.iter().copied().chain(std::iter::repeat_n(1.0, params.len())).collect()
+                } else {
+                    null_start
+                }
+            });
         let jac0 = if c.discrete() {
             lin.jac.clone()
         } else {
