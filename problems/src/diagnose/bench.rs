@@ -82,6 +82,8 @@ pub struct CaseResult {
     pub ranking: Vec<(String, f64, bool)>,
     /// χ²/dof of the base fit.
     pub base_reduced_chi2: f64,
+    /// Whether the base fit is at the noise level (the planted effect is then undetectable).
+    pub base_at_noise_level: bool,
     /// χ²/dof with the true effect refitted.
     pub true_reduced_chi2: Option<f64>,
     /// Whether the refit with the true effect is at the noise level.
@@ -173,6 +175,7 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         diagnosed: NONE.into(),
         ranking: Vec::new(),
         base_reduced_chi2: f64::NAN,
+        base_at_noise_level: false,
         true_reduced_chi2: None,
         true_at_noise_level: None,
         true_refit: Vec::new(),
@@ -234,6 +237,7 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         };
         let d = diagnose_subject(&subject, &u0, library, &opts)?;
         out.base_reduced_chi2 = d.base.reduced_chi2;
+        out.base_at_noise_level = d.base.at_noise_level;
         out.ranking = d
             .candidates
             .iter()
@@ -372,11 +376,40 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
         let cells: Vec<String> = row.iter().map(|c| c.to_string()).collect();
         let _ = writeln!(s, "| {l} | {} |", cells.join(" | "));
     }
-    let _ = writeln!(s, "\n| effect | top-1 | top-2 | true effect at noise level |\n|---|---|---|---|");
+    let _ = writeln!(
+        s,
+        "\n| effect | top-1 | top-2 | detectable (base fit above the noise) | top-1 of detectable | true effect at noise level |\n|---|---|---|---|---|---|"
+    );
     for (e, t1) in &r.top1 {
         let mine: Vec<&CaseResult> = r.cases.iter().filter(|c| &c.planted == e).collect();
         let at = mine.iter().filter(|c| c.true_at_noise_level == Some(true)).count();
-        let _ = writeln!(s, "| {e} | {:.0}% | {:.0}% | {at}/{} |", 100.0 * t1, 100.0 * r.top2[e], mine.len());
+        let seen: Vec<&&CaseResult> = mine.iter().filter(|c| !c.base_at_noise_level).collect();
+        let hit = seen.iter().filter(|c| &c.diagnosed == e).count();
+        let _ = writeln!(
+            s,
+            "| {e} | {:.0}% | {:.0}% | {}/{} | {hit}/{} | {at}/{} |",
+            100.0 * t1,
+            100.0 * r.top2[e],
+            seen.len(),
+            mine.len(),
+            seen.len(),
+            mine.len()
+        );
+    }
+    // Confusions actually observed: a fifth or more of an effect's cases named as another.
+    let _ = writeln!(s, "\nObserved confusions (≥ 20 % of an effect's cases diagnosed as another):\n");
+    let mut any = false;
+    for (i, row) in r.confusion.iter().enumerate() {
+        let total: usize = row.iter().sum();
+        for (j, &k) in row.iter().enumerate() {
+            if i != j && r.labels[j] != NONE && r.labels[i] != NONE && total > 0 && k * 5 >= total {
+                any = true;
+                let _ = writeln!(s, "* {} diagnosed as {}: {k}/{total}", r.labels[i], r.labels[j]);
+            }
+        }
+    }
+    if !any {
+        let _ = writeln!(s, "* none");
     }
     let _ = writeln!(s, "\nFalse alarms on null cases: {:.0}%.", 100.0 * r.false_alarms);
     let _ = writeln!(
