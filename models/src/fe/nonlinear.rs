@@ -608,9 +608,11 @@ impl<'a> Solver<'a> {
         // Safeguard against branch cycling (a cracking fibre or a softening interface point
         // flipping between loading and unloading from one iteration to the next): a correction
         // that increased the residual is halved, and the next iterations use secant stiffnesses (a
-        // fixed-point iteration that settles the active set) before Newton resumes.
+        // fixed-point iteration that settles the active set) before Newton resumes; with
+        // extrapolated damage the halving goes further instead (a line search), see below.
+        // Normal statuses start from the committed gaps, fibres with no flips.
         self.open.iter_mut().zip(&c.gaps).for_each(|(o, g)| *o = g[0] > 0.0);
-        let mut releases = 0usize;
+        let mut corrections = 0usize;
         self.fibre_loading.iter_mut().for_each(|v| *v = false);
         self.fibre_flips.iter_mut().for_each(|v| *v = 0);
         self.fibre_unloading.iter_mut().for_each(|v| *v = false);
@@ -640,11 +642,11 @@ impl<'a> Solver<'a> {
                 // plate lying on the soffit keeps switching points between touching and lifting by
                 // fractions of a micrometre; the statuses then stay as they are for this step
                 // (explicit, like the damage) and are taken from the converged gaps for the next.
-                if releases >= 2 || !self.correct_status(tol) {
+                if corrections >= 2 || !self.correct_status(tol) {
                     return Some(it);
                 }
                 // A new start for the iterations with the corrected statuses.
-                releases += 1;
+                corrections += 1;
                 r_prev = f64::INFINITY;
                 it = 0;
                 continue;
