@@ -18,6 +18,8 @@ use std::time::Instant;
 
 /// Significance of the base misfit against the noise (χ² with n − p degrees of freedom).
 const NOISE_LEVEL: f64 = 1e-3;
+/// Realised shrinkage below which the held-out late stage is not refitted for a candidate.
+const TRANSFER_FROM: f64 = 0.05;
 /// Cosine above which two candidates are reported as confusable.
 pub const CONFUSABLE: f64 = 0.9;
 
@@ -332,7 +334,7 @@ fn refit_on(
 const REFIT: LsOptions = LsOptions { max_iterations: 40, step: 2e-3, tolerance: 1e-6, fd_jacobians: 3 };
 /// A switched-on effect only moves the fitted parameters, whose Jacobian barely changes with it;
 /// its runs can be far dearer (large rotations), so fewer iterations and one fresh Jacobian.
-const REFIT_SWITCH: LsOptions = LsOptions { max_iterations: 10, step: 2e-3, tolerance: 1e-4, fd_jacobians: 1 };
+const REFIT_SWITCH: LsOptions = LsOptions { max_iterations: 8, step: 2e-3, tolerance: 1e-4, fd_jacobians: 1 };
 
 fn select_rows(m: &DMatrix<f64>, rows: &[usize]) -> DMatrix<f64> {
     DMatrix::from_fn(rows.len(), m.ncols(), |i, j| m[(rows[i], j)])
@@ -652,8 +654,22 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         if best_records.is_none() {
             best_records = Some((c.name().to_string(), out.misfit.records));
         }
-        // Transfer 1: the late stage of every curve, held out of both fits.
-        if let Some(base_late) = holdout_base {
+        // Transfer 1: the late stage of every curve, held out of both fits. An effect that barely
+        // changes the fit has nothing to transfer, and its refit may be dear (large rotations).
+        let realised = 1.0 - chi / chi2.max(f64::MIN_POSITIVE);
+        if holdout_base.is_some() && realised < TRANSFER_FROM {
+            res.transfer.push(Transfer {
+                withheld: "late stage of each curve".into(),
+                readings: late.len(),
+                base_chi2: holdout_base.unwrap_or(f64::NAN),
+                effect_chi2: None,
+                shrinkage: None,
+                note: Some(format!(
+                    "not checked: the effect removes under {:.0}% of the misfit",
+                    100.0 * TRANSFER_FROM
+                )),
+            });
+        } else if let Some(base_late) = holdout_base {
             say(&format!("{}: fit without the late stage, predict it", c.name()));
             let jac_early = out.jacobian.as_ref().map(|j| select_rows(j, &early_rows));
             let t = refit_on(&early, &base, &space, *c, &params, &out.v, jac_early).and_then(|o| {
