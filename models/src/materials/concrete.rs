@@ -107,13 +107,17 @@ impl Concrete {
     }
 
     /// Envelope stress and slope at `strain` (monotonic loading from zero).
+    #[inline]
     fn envelope_with_slope(&self, strain: f64) -> (f64, f64) {
         let (fc, ft, ec) = (self.compressive_strength, self.tensile_strength, self.elastic_modulus);
         if strain >= 0.0 {
-            let (et, ef) = (self.cracking_strain(), self.tension_end_strain());
+            // The end of the softening branch only past cracking (most fibres are elastic).
+            let et = self.cracking_strain();
             if strain <= et {
-                (ec * strain, ec)
-            } else if strain < ef {
+                return (ec * strain, ec);
+            }
+            let ef = self.tension_end_strain();
+            if strain < ef {
                 let slope = -ft / (ef - et);
                 (ft + slope * (strain - et), slope)
             } else {
@@ -135,6 +139,94 @@ impl Concrete {
                 }
             }
         }
+    }
+}
+
+/// A [`Concrete`] with the constants of its curve worked out once, for evaluation in inner loops:
+/// [`PreparedConcrete::respond`] gives exactly [`Concrete::respond`]'s results.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedConcrete {
+    fc: f64,
+    ft: f64,
+    ec: f64,
+    /// Cracking strain `f_t/E_c`.
+    et: f64,
+    /// End of tension softening.
+    ef: f64,
+    /// Slope of the tension softening.
+    softening: f64,
+    /// Peak strain magnitude `ε_c0`.
+    e0: f64,
+    /// `2 f_c/ε_c0`, the parabola's slope at zero.
+    c2: f64,
+    /// Slope of the descending compression line.
+    descent: f64,
+}
+
+impl Concrete {
+    /// The concrete with its constants worked out (see [`PreparedConcrete`]).
+    pub fn prepared(&self) -> PreparedConcrete {
+        let (fc, ft) = (self.compressive_strength, self.tensile_strength);
+        let (et, ef, e0) = (self.cracking_strain(), self.tension_end_strain(), self.peak_strain());
+        PreparedConcrete {
+            fc,
+            ft,
+            ec: self.elastic_modulus,
+            et,
+            ef,
+            softening: -ft / (ef - et),
+            e0,
+            c2: 2.0 * fc / e0,
+            descent: self.descent(),
+        }
+    }
+}
+
+impl PreparedConcrete {
+    /// [`Concrete::envelope_with_slope`] with the constants at hand.
+    #[inline(always)]
+    fn envelope_with_slope(&self, strain: f64) -> (f64, f64) {
+        if strain >= 0.0 {
+            if strain <= self.et {
+                (self.ec * strain, self.ec)
+            } else if strain < self.ef {
+                (self.ft + self.softening * (strain - self.et), self.softening)
+            } else {
+                (0.0, 0.0)
+            }
+        } else {
+            let e = -strain;
+            if e <= self.e0 {
+                let x = e / self.e0;
+                (-self.fc * x * (2.0 - x), self.c2 * (1.0 - x))
+            } else {
+                let magnitude = self.fc - self.descent * (e - self.e0);
+                if magnitude > 0.0 {
+                    (-magnitude, -self.descent)
+                } else {
+                    (0.0, 0.0)
+                }
+            }
+        }
+    }
+
+    /// Exactly [`Concrete::respond`].
+    #[inline(always)]
+    pub fn respond(&self, strain: f64, previous: &UniaxialState) -> UniaxialResponse {
+        let [max_tension, max_compression] = previous.history;
+        let mut state = *previous;
+        let (stress, tangent) = if strain >= 0.0 && strain > max_tension {
+            state.history[0] = strain;
+            self.envelope_with_slope(strain)
+        } else if strain < 0.0 && strain < max_compression {
+            state.history[1] = strain;
+            self.envelope_with_slope(strain)
+        } else {
+            let reached = if strain >= 0.0 { max_tension } else { max_compression };
+            let secant = if reached == 0.0 { self.ec } else { self.envelope_with_slope(reached).0 / reached };
+            (secant * strain, secant)
+        };
+        UniaxialResponse { stress, tangent, state }
     }
 }
 
@@ -178,6 +270,7 @@ impl UniaxialMaterial for Concrete {
         Ok(())
     }
 
+    #[inline]
     fn respond(&self, strain: f64, previous: &UniaxialState) -> UniaxialResponse {
         let [max_tension, max_compression] = previous.history;
         let mut state = *previous;
@@ -291,6 +384,28 @@ mod tests {
         // Reloading past the largest strain rejoins the envelope.
         let beyond = c.respond(1.1 * strain, &half.state);
         assert_eq!(beyond.stress, c.envelope(1.1 * strain));
+    }
+
+    #[test]
+    fn prepared_concrete_gives_the_same_results() {
+        for band in [10.0, 150.0] {
+            let c = Concrete { crack_band: band, ..concrete() };
+            let prepared = c.prepared();
+            let (et, e0) = (c.cracking_strain(), c.peak_strain());
+            let strains: Vec<f64> =
+                (-400..=400).map(|i| i as f64 * 0.01 * e0).chain((0..200).map(|i| i as f64 * 0.1 * et)).collect();
+            let mut states = vec![UniaxialState::default()];
+            for &s in &[0.5 * et, 3.0 * et, 40.0 * et, -0.5 * e0, -1.5 * e0, -3.0 * e0] {
+                let last = *states.last().unwrap();
+                states.push(c.respond(s, &last).state);
+                states.push(c.respond(s, &UniaxialState::default()).state);
+            }
+            for state in &states {
+                for &s in &strains {
+                    assert_eq!(prepared.respond(s, state), c.respond(s, state), "{s} from {state:?}");
+                }
+            }
+        }
     }
 
     #[test]

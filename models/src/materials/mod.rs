@@ -15,9 +15,9 @@ pub mod concrete;
 pub mod frp;
 pub mod steel;
 
-pub use concrete::Concrete;
+pub use concrete::{Concrete, PreparedConcrete};
 pub use frp::Frp;
-pub use steel::Steel;
+pub use steel::{PreparedSteel, Steel};
 
 use czid_core::Result;
 use serde::{Deserialize, Serialize};

@@ -56,6 +56,53 @@ impl Steel {
     }
 }
 
+/// A [`Steel`] with its plastic modulus worked out once: [`PreparedSteel::respond`] gives exactly
+/// [`Steel::respond`]'s results.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedSteel {
+    e: f64,
+    fy: f64,
+    eh: f64,
+    h: f64,
+}
+
+impl Steel {
+    /// The steel with its plastic modulus worked out (see [`PreparedSteel`]).
+    pub fn prepared(&self) -> PreparedSteel {
+        PreparedSteel {
+            e: self.elastic_modulus,
+            fy: self.yield_strength,
+            eh: self.hardening_modulus,
+            h: self.plastic_modulus(),
+        }
+    }
+}
+
+impl PreparedSteel {
+    /// Young's modulus (MPa).
+    #[inline(always)]
+    pub fn elastic_modulus(&self) -> f64 {
+        self.e
+    }
+
+    /// Exactly [`Steel::respond`].
+    #[inline(always)]
+    pub fn respond(&self, strain: f64, previous: &UniaxialState) -> UniaxialResponse {
+        let (e, h) = (self.e, self.h);
+        let plastic = previous.history[0];
+        let trial = e * (strain - plastic);
+        let relative = trial - h * plastic;
+        let excess = relative.abs() - self.fy;
+        if excess <= 0.0 {
+            return UniaxialResponse { stress: trial, tangent: e, state: *previous };
+        }
+        let increment = excess / (e + h) * relative.signum();
+        let mut state = *previous;
+        state.history[0] = plastic + increment;
+        UniaxialResponse { stress: trial - e * increment, tangent: self.eh, state }
+    }
+}
+
 impl UniaxialMaterial for Steel {
     fn validate(&self) -> Result<()> {
         require_positive(OWNER, "elastic_modulus", self.elastic_modulus)?;
@@ -72,6 +119,7 @@ impl UniaxialMaterial for Steel {
         Ok(())
     }
 
+    #[inline]
     fn respond(&self, strain: f64, previous: &UniaxialState) -> UniaxialResponse {
         let (e, h) = (self.elastic_modulus, self.plastic_modulus());
         let plastic = previous.history[0];
@@ -130,6 +178,20 @@ mod tests {
             let h = 1e-8;
             let fd = (s.respond(strain + h, &state).stress - s.respond(strain - h, &state).stress) / (2.0 * h);
             assert!((s.respond(strain, &state).tangent - fd).abs() < 1e-4 * fd, "{strain}");
+        }
+    }
+
+    #[test]
+    fn prepared_steel_gives_the_same_results() {
+        let s = steel();
+        let prepared = s.prepared();
+        let loaded = s.respond(0.01, &UniaxialState::default()).state;
+        let reversed = s.respond(-0.01, &loaded).state;
+        for state in [UniaxialState::default(), loaded, reversed] {
+            for i in -300..=300 {
+                let strain = i as f64 * 5e-5;
+                assert_eq!(prepared.respond(strain, &state), s.respond(strain, &state), "{strain}");
+            }
         }
     }
 
