@@ -17,7 +17,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::materials::{Concrete, Steel, UniaxialMaterial, UniaxialResponse, UniaxialState};
+use super::banded::BandMatrix;
+use super::mesh::NONE;
+use crate::materials::{
+    Concrete, PreparedConcrete, PreparedSteel, Steel, UniaxialMaterial, UniaxialResponse, UniaxialState,
+};
 
 /// The material of a fibre.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -123,6 +127,118 @@ impl FibreMaterial {
     }
 }
 
+/// A [`FibreMaterial`] with its constants worked out once (see [`FibreMaterial::prepared`]): the
+/// same stresses, tangents and states, for the inner loops of an assembly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PreparedMaterial {
+    /// [`FibreMaterial::Concrete`].
+    Concrete(PreparedConcrete),
+    /// [`FibreMaterial::Steel`].
+    Steel(PreparedSteel),
+    /// [`FibreMaterial::UncrackedConcrete`] (the concrete and its elastic modulus).
+    UncrackedConcrete(PreparedConcrete, f64),
+    /// [`FibreMaterial::CrackedConcrete`].
+    CrackedConcrete(PreparedConcrete, f64),
+    /// [`FibreMaterial::CrackSteel`].
+    CrackSteel(PreparedSteel, f64),
+}
+
+impl FibreMaterial {
+    /// The material with its constants worked out.
+    pub fn prepared(&self) -> PreparedMaterial {
+        match self {
+            FibreMaterial::Concrete(c) => PreparedMaterial::Concrete(c.prepared()),
+            FibreMaterial::Steel(s) => PreparedMaterial::Steel(s.prepared()),
+            FibreMaterial::UncrackedConcrete(c) => PreparedMaterial::UncrackedConcrete(c.prepared(), c.elastic_modulus),
+            FibreMaterial::CrackedConcrete { concrete, ratio } => {
+                PreparedMaterial::CrackedConcrete(concrete.prepared(), *ratio)
+            }
+            FibreMaterial::CrackSteel { steel, ratio } => PreparedMaterial::CrackSteel(steel.prepared(), *ratio),
+        }
+    }
+}
+
+impl PreparedMaterial {
+    /// Exactly [`FibreMaterial::respond`].
+    #[inline(always)]
+    pub fn respond(&self, strain: f64, state: &UniaxialState) -> UniaxialResponse {
+        match self {
+            PreparedMaterial::Concrete(c) => c.respond(strain, state),
+            PreparedMaterial::Steel(s) => s.respond(strain, state),
+            PreparedMaterial::UncrackedConcrete(c, ec) => {
+                if strain < 0.0 {
+                    c.respond(strain, state)
+                } else {
+                    UniaxialResponse { stress: ec * strain, tangent: *ec, state: *state }
+                }
+            }
+            PreparedMaterial::CrackedConcrete(c, ratio) => {
+                if strain < 0.0 {
+                    let mut r = c.respond(strain * ratio, state);
+                    r.tangent *= ratio;
+                    r
+                } else {
+                    UniaxialResponse { stress: 0.0, tangent: 0.0, state: *state }
+                }
+            }
+            PreparedMaterial::CrackSteel(s, ratio) => {
+                let mut r = s.respond(strain * ratio, state);
+                r.tangent *= ratio;
+                r
+            }
+        }
+    }
+
+    /// Exactly [`FibreMaterial::unloading_stiffness`].
+    #[inline]
+    pub fn unloading_stiffness(&self, strain: f64, stress: f64) -> f64 {
+        match self {
+            PreparedMaterial::Steel(s) => s.elastic_modulus(),
+            PreparedMaterial::CrackSteel(s, ratio) => s.elastic_modulus() * ratio,
+            PreparedMaterial::Concrete(_)
+            | PreparedMaterial::UncrackedConcrete(..)
+            | PreparedMaterial::CrackedConcrete(..) => {
+                if strain.abs() > 1e-12 {
+                    (stress / strain).max(0.0)
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// Exactly [`FibreMaterial::step_work`].
+    #[inline]
+    pub fn step_work(&self, state: &UniaxialState, (e0, s0): (f64, f64), (e1, s1): (f64, f64)) -> f64 {
+        if e1 == e0 {
+            return 0.0;
+        }
+        let sm = self.respond(0.5 * (e0 + e1), state).stress;
+        (e1 - e0) / 6.0 * (s0 + 4.0 * sm + s1)
+    }
+}
+
+/// A fibre of a [`FibreSection`] with its material prepared ([`FibreSection::prepared`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedFibre {
+    /// [`Fibre::z`].
+    pub z: f64,
+    /// [`Fibre::area`].
+    pub area: f64,
+    /// [`Fibre::initial_strain`].
+    pub initial_strain: f64,
+    /// The fibre's material.
+    pub material: PreparedMaterial,
+}
+
+impl PreparedFibre {
+    /// Exactly [`FibreSection::strain`] of the fibre.
+    #[inline(always)]
+    pub fn strain(&self, e: [f64; 2]) -> f64 {
+        e[0] - self.z * e[1] - self.initial_strain
+    }
+}
+
 /// One fibre of a section.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fibre {
@@ -159,6 +275,19 @@ impl FibreSection {
     #[inline]
     pub fn strain(&self, f: &Fibre, e: [f64; 2]) -> f64 {
         e[0] - f.z * e[1] - f.initial_strain
+    }
+
+    /// The fibres with their materials prepared, in order.
+    pub fn prepared(&self) -> Vec<PreparedFibre> {
+        self.fibres
+            .iter()
+            .map(|f| PreparedFibre {
+                z: f.z,
+                area: f.area,
+                initial_strain: f.initial_strain,
+                material: self.materials[f.material].prepared(),
+            })
+            .collect()
     }
 
     /// Section forces and tangent at `e` from the committed `states` (one per fibre); the trial
@@ -231,4 +360,48 @@ pub fn element(l: f64, s: &SectionResponse) -> ([f64; 6], [[f64; 6]; 6]) {
         }
     }
     (f, k)
+}
+
+/// `B` of an element of length `l` by columns `[u1, θ1, u2, θ2]` (the others are zero): the
+/// column's index among `[u1, w1, θ1, u2, w2, θ2]`, its one non-zero entry `±1/l` and that
+/// entry's row (0: `ε`, 1: `κ`).
+#[inline]
+fn b_columns(l: f64) -> [(usize, f64, usize); 4] {
+    let (bn, bp) = (-1.0 / l, 1.0 / l);
+    [(0, bn, 0), (2, bn, 1), (3, bp, 0), (5, bp, 1)]
+}
+
+/// Adds the nodal forces of [`element`] (section forces `s.force`) to `f` at the element's
+/// unknowns `dofs` (`[u1, w1, θ1, u2, w2, θ2]`, [`NONE`] for none); `false` if one is not finite.
+#[inline]
+pub fn element_forces(l: f64, s: &SectionResponse, dofs: &[usize; 6], f: &mut [f64]) -> bool {
+    let mut ok = true;
+    for (a, ba, ra) in b_columns(l) {
+        // `element`'s sum `(B₀ᵢ N + B₁ᵢ M) l` has this one non-zero term.
+        let fa = ba * s.force[ra] * l;
+        ok &= fa.is_finite();
+        if dofs[a] != NONE {
+            f[dofs[a]] += fa;
+        }
+    }
+    ok
+}
+
+/// Adds the tangent `Bᵀ D B l` of [`element`] (section tangent `d`) to `k` at the element's
+/// unknowns `dofs`, only its non-zero (`u` and `θ`) entries.
+#[inline]
+pub fn scatter_tangent(l: f64, d: &[[f64; 2]; 2], dofs: &[usize; 6], k: &mut BandMatrix) {
+    let cols = b_columns(l);
+    for &(a, ba, ra) in &cols {
+        let da = dofs[a];
+        if da == NONE {
+            continue;
+        }
+        for &(b, bb, rb) in &cols {
+            if dofs[b] != NONE {
+                // `element`'s sum over `B D B` has this one non-zero term.
+                k.add(da, dofs[b], ba * d[ra][rb] * bb * l);
+            }
+        }
+    }
 }

@@ -35,7 +35,7 @@
 //! linear layers' exact strain energy, the fibres' recoverable energy and the interface's
 //! (law plus compliance, `½ T·C T`); dissipated energy of the interface (work along each point's gap
 //! path by [`super::energy::path_work`] minus its recoverable energy) and of the fibres (work by
-//! [`FibreMaterial::step_work`] minus recoverable energy), each integrated point by point and
+//! [`fibre::FibreMaterial::step_work`] minus recoverable energy), each integrated point by point and
 //! independently of the external work, so `W = U + D_interface + D_material` is a genuine check.
 //!
 //! **Initial strains** (shrinkage): if a fibre has one, the unloaded structure is first brought to
@@ -50,7 +50,7 @@ use super::banded::BandMatrix;
 use super::beam;
 use super::crack::{self, CrackMeasures};
 use super::energy::path_work;
-use super::fibre::{self, FibreMaterial, FibreSection};
+use super::fibre::{self, FibreSection};
 use super::interface::{self, InterfacePoint, PointKind};
 use super::mesh::{Mesh, NONE};
 use super::newton::NewtonSettings;
@@ -224,6 +224,8 @@ struct Solver<'a> {
     law: &'a dyn CohesiveLaw,
     elements: Vec<Element>,
     fibre_elements: Vec<FibreElement>,
+    /// The fibres of each section of each fibre layer, their materials prepared.
+    prepared: Vec<Vec<Vec<fibre::PreparedFibre>>>,
     linear: BandMatrix,
     k: BandMatrix,
     f: Vec<f64>,
@@ -232,7 +234,13 @@ struct Solver<'a> {
     /// Trial results of the last assembly.
     trial: History,
     iteration_tangents: Vec<Tangent>,
+    /// Section tangents `∂[N, M]/∂[ε, κ]` of the fibre elements at the last assembly.
+    section_tangents: Vec<[[f64; 2]; 2]>,
+    /// Gap kinematics of the interface points (small rotations: `∂g/∂q` is constant).
+    kinematics: Vec<interface::GapKinematics>,
     load: Vec<f64>,
+    /// Work vectors of the Newton iterations.
+    work: Vec<Vec<f64>>,
     settings: NewtonSettings,
     stats: NonlinearStats,
     with_compliance: bool,
@@ -376,6 +384,10 @@ impl<'a> Solver<'a> {
             strains: vec![0.0; nfib],
             stresses: vec![0.0; nfib],
         };
+        let section_tangents = vec![[[0.0; 2]; 2]; fibre_elements.len()];
+        let zero = vec![0.0; n];
+        let mut hess = [[[0.0; 8]; 8]; 2];
+        let kinematics = p.points.iter().map(|pt| interface::kinematics(mesh, pt, &zero, false, &mut hess)).collect();
         let mut fixed_mask = vec![false; n];
         for &d in &p.fixed {
             fixed_mask[d] = true;
@@ -389,6 +401,7 @@ impl<'a> Solver<'a> {
             law,
             elements,
             fibre_elements,
+            prepared: p.fibre_layers.iter().map(|fl| fl.sections.iter().map(|sec| sec.prepared()).collect()).collect(),
             k: BandMatrix::zeros(n, mesh.bandwidth()),
             linear,
             f: vec![0.0; n],
@@ -396,7 +409,10 @@ impl<'a> Solver<'a> {
             strength: strengths(law),
             trial,
             iteration_tangents: vec![Tangent::zeros(); np],
+            section_tangents,
+            kinematics,
             load,
+            work: Vec::new(),
             settings,
             stats: NonlinearStats::default(),
             with_compliance: p.compliance != [0.0, 0.0],
@@ -410,54 +426,68 @@ impl<'a> Solver<'a> {
         }
     }
 
-    /// Internal forces and tangent at `q` from the committed history `c`; `false` if something
-    /// is not finite (or a series-compliance solve failed).
+    /// Internal forces at `q` from the committed history `c`, with the trial history and the
+    /// stiffnesses [`Solver::tangent`] assembles; `false` if something is not finite (or a
+    /// series-compliance solve failed).
     fn assemble(&mut self, c: &History, q: &[f64], secant: bool) -> bool {
         self.stats.assemblies += 1;
         let p = self.p;
-        self.k.copy_from(&self.linear);
         self.linear.mul_vec(q, &mut self.f);
         let mut ok = true;
-        for fe in &self.fibre_elements {
-            let sec = &p.fibre_layers[fe.fl].sections[fe.section];
+        for (ie, fe) in self.fibre_elements.iter().enumerate() {
+            let fibres = &self.prepared[fe.fl][fe.section];
             let mut qe = [0.0; 6];
             for (v, &d) in qe.iter_mut().zip(&fe.dofs) {
                 *v = get(q, d);
             }
             let e = fibre::strains(fe.len, &qe);
-            let nf = sec.fibres.len();
+            let nf = fibres.len();
             let range = fe.first..fe.first + nf;
-            let r = sec.respond(
-                e,
-                &c.fibres[range.clone()],
-                &mut self.trial.fibres[range.clone()],
-                &mut self.trial.stresses[range.clone()],
-                secant,
-                &self.fibre_unloading[range.clone()],
-            );
-            // A fibre that keeps switching between loading and unloading from one iteration to
-            // the next (a bar at yield, concrete at its envelope) sits on its loading surface in
-            // the solution, where Newton's tangents on either side send it across: its unloading
-            // stiffness, stiffer than its tangent, makes the iterations contract there.
-            for k in range.clone() {
-                let loading = self.trial.fibres[k] != c.fibres[k];
-                if loading != self.fibre_loading[k] {
-                    self.fibre_loading[k] = loading;
-                    self.fibre_flips[k] = self.fibre_flips[k].saturating_add(1);
-                    self.fibre_unloading[k] = self.fibre_flips[k] >= 3;
+            let committed = &c.fibres[range.clone()];
+            let trial = &mut self.trial.fibres[range.clone()];
+            let stresses = &mut self.trial.stresses[range.clone()];
+            let strains = &mut self.trial.strains[range.clone()];
+            let loading_flags = &mut self.fibre_loading[range.clone()];
+            let flips = &mut self.fibre_flips[range.clone()];
+            let unloading = &mut self.fibre_unloading[range];
+            // The section response (`FibreSection::respond`) and the fibres' bookkeeping in one
+            // pass over the fibres.
+            let mut r = fibre::SectionResponse::default();
+            for (k, f) in fibres.iter().enumerate() {
+                let mat = &f.material;
+                let mech = f.strain(e);
+                let res = mat.respond(mech, &committed[k]);
+                trial[k] = res.state;
+                stresses[k] = res.stress;
+                strains[k] = mech;
+                let stiffness = if unloading[k] {
+                    mat.unloading_stiffness(mech, res.stress)
+                } else if secant && mech.abs() > 1e-12 {
+                    (res.stress / mech).max(0.0)
+                } else {
+                    res.tangent
+                };
+                let (fa, ka) = (res.stress * f.area, stiffness * f.area);
+                r.force[0] += fa;
+                r.force[1] -= fa * f.z;
+                r.tangent[0][0] += ka;
+                r.tangent[0][1] -= ka * f.z;
+                r.tangent[1][1] += ka * f.z * f.z;
+                // A fibre that keeps switching between loading and unloading from one iteration
+                // to the next (a bar at yield, concrete at its envelope) sits on its loading
+                // surface in the solution, where Newton's tangents on either side send it across:
+                // its unloading stiffness, stiffer than its tangent, makes the iterations contract
+                // there (from the next assembly on).
+                let loading = res.state != committed[k];
+                if loading != loading_flags[k] {
+                    loading_flags[k] = loading;
+                    flips[k] = flips[k].saturating_add(1);
+                    unloading[k] = flips[k] >= 3;
                 }
             }
-            for (k, fib) in sec.fibres.iter().enumerate() {
-                self.trial.strains[fe.first + k] = sec.strain(fib, e);
-            }
-            let (fv, kv) = fibre::element(fe.len, &r);
-            for (a, &da) in fe.dofs.iter().enumerate() {
-                if da != NONE {
-                    self.f[da] += fv[a];
-                }
-            }
-            scatter(&mut self.k, &fe.dofs, &kv);
-            ok &= fv.iter().all(|v| v.is_finite());
+            r.tangent[1][0] = r.tangent[0][1];
+            ok &= fibre::element_forces(fe.len, &r, &fe.dofs, &mut self.f);
+            self.section_tangents[ie] = r.tangent;
         }
         let mut hess = [[[0.0; 8]; 8]; 2];
         for (ip, pt) in p.points.iter().enumerate() {
@@ -494,10 +524,29 @@ impl<'a> Solver<'a> {
             let g = &kin.grad;
             for a in 0..8 {
                 let da = kin.dofs[a];
+                if da != NONE && (g[0][a] != 0.0 || g[1][a] != 0.0) {
+                    self.f[da] += w * (g[0][a] * t[0] + g[1][a] * t[1]);
+                }
+            }
+        }
+        ok
+    }
+
+    /// The tangent at the last assembly into `k`: the linear layers', the fibre elements' from
+    /// their section tangents, the interface points' from their iteration stiffnesses.
+    fn tangent(&mut self) {
+        self.k.copy_from(&self.linear);
+        for (fe, st) in self.fibre_elements.iter().zip(&self.section_tangents) {
+            fibre::scatter_tangent(fe.len, st, &fe.dofs, &mut self.k);
+        }
+        for ((pt, kin), d) in self.p.points.iter().zip(&self.kinematics).zip(&self.iteration_tangents) {
+            let w = pt.area * pt.factor;
+            let g = &kin.grad;
+            for a in 0..8 {
+                let da = kin.dofs[a];
                 if da == NONE || (g[0][a] == 0.0 && g[1][a] == 0.0) {
                     continue;
                 }
-                self.f[da] += w * (g[0][a] * t[0] + g[1][a] * t[1]);
                 let ra0 = g[0][a] * d[(0, 0)] + g[1][a] * d[(1, 0)];
                 let ra1 = g[0][a] * d[(0, 1)] + g[1][a] * d[(1, 1)];
                 for b in 0..8 {
@@ -512,7 +561,6 @@ impl<'a> Solver<'a> {
                 }
             }
         }
-        ok
     }
 
     /// A point with the fixed damage `dex` (secant `(1 − D) K` in slip and opening, `K` in
@@ -600,10 +648,32 @@ impl<'a> Solver<'a> {
     /// Newton's method at control `c_target` (`None`: at zero load, no control) from the predictor
     /// `q`, `load`; returns the iterations on success.
     fn solve(&mut self, c: &History, q: &mut [f64], load: &mut f64, c_target: Option<f64>) -> Option<usize> {
+        // The work vectors are kept from one step to the next.
+        let mut work = std::mem::take(&mut self.work);
+        work.resize_with(3, Vec::new);
+        for v in work.iter_mut() {
+            v.clear();
+            v.resize(q.len(), 0.0);
+        }
+        let [r, b, dq] = &mut work[..] else { unreachable!() };
+        let result = self.newton(c, q, load, c_target, r, b, dq);
+        self.work = work;
+        result
+    }
+
+    /// [`Solver::solve`] with the work vectors `r`, `b`, `dq` (zeros of the length of `q`).
+    #[allow(clippy::too_many_arguments)]
+    fn newton(
+        &mut self,
+        c: &History,
+        q: &mut [f64],
+        load: &mut f64,
+        c_target: Option<f64>,
+        r: &mut [f64],
+        b: &mut [f64],
+        dq: &mut [f64],
+    ) -> Option<usize> {
         let n = q.len();
-        let mut r = vec![0.0; n];
-        let mut b = vec![0.0; n];
-        let mut dq = vec![0.0; n];
         let mut dload = 0.0;
         // Safeguard against branch cycling (a cracking fibre or a softening interface point
         // flipping between loading and unloading from one iteration to the next): a correction
@@ -659,7 +729,7 @@ impl<'a> Solver<'a> {
                 if self.extrapolated.is_some() { (1.0 / 32.0, 0) } else { (0.3, self.secant_iterations) };
             if rmax > r_prev && alpha > min_alpha {
                 alpha *= 0.5;
-                for (qi, di) in q.iter_mut().zip(&dq) {
+                for (qi, di) in q.iter_mut().zip(dq.iter()) {
                     *qi -= alpha * di;
                 }
                 *load -= alpha * dload;
@@ -674,6 +744,7 @@ impl<'a> Solver<'a> {
             secant_left = secant_left.saturating_sub(1);
             r_prev = rmax;
             alpha = 1.0;
+            self.tangent();
             for &d in &self.p.fixed {
                 self.k.set_identity_row_col(d);
             }
@@ -683,7 +754,7 @@ impl<'a> Solver<'a> {
                 for i in 0..n {
                     b[i] = if self.fixed_mask[i] { 0.0 } else { self.load[i] };
                 }
-                self.k.solve2_in_place(&mut r, &mut b);
+                self.k.solve2_in_place(r, b);
                 let a1: f64 = self.p.control.iter().map(|&(d, a)| a * r[d]).sum();
                 let a2: f64 = self.p.control.iter().map(|&(d, a)| a * b[d]).sum();
                 if a2 == 0.0 || !a2.is_finite() {
@@ -696,10 +767,10 @@ impl<'a> Solver<'a> {
                 }
                 *load += dload;
             } else {
-                self.k.solve_in_place(&mut r);
+                self.k.solve_in_place(r);
                 dload = 0.0;
-                dq.copy_from_slice(&r);
-                for (qi, ri) in q.iter_mut().zip(&r) {
+                dq.copy_from_slice(r);
+                for (qi, ri) in q.iter_mut().zip(r.iter()) {
                     *qi += ri;
                 }
             }
@@ -940,11 +1011,9 @@ pub fn run(
                     totals.interface_work += pt.area * pt.factor * w;
                 }
                 for fe in &s.fibre_elements {
-                    let sec = &p.fibre_layers[fe.fl].sections[fe.section];
-                    for (k, f) in sec.fibres.iter().enumerate() {
+                    for (k, f) in s.prepared[fe.fl][fe.section].iter().enumerate() {
                         let i = fe.first + k;
-                        let m: &FibreMaterial = &sec.materials[f.material];
-                        let w = m.step_work(
+                        let w = f.material.step_work(
                             &committed.fibres[i],
                             (committed.strains[i], committed.stresses[i]),
                             (s.trial.strains[i], s.trial.stresses[i]),
