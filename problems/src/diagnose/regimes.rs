@@ -2,9 +2,9 @@
 //! misfit of each response summed per regime, with its sign.
 //!
 //! Regimes of a load–displacement curve (any test that loads, peaks and softens):
-//! * **initial loading**: from the start while the secant stiffness `P/δ` stays within 5 % of
-//!   its largest value before the peak (linear response; a seating toe only delays that largest
-//!   value; readings below 10 % of the peak load, mostly noise, do not count);
+//! * **initial loading**: from the start until the load falls for good below 95 % of the initial
+//!   line, the line through the readings at 10 % and 40 % of the peak load (so that a seating toe
+//!   or a preload offset does not count as non-linearity);
 //! * **onset / peak**: from there until the load has fallen 5 % below its peak (damage onset,
 //!   crack initiation);
 //! * **propagation**: from there over the first two thirds of the remaining displacement range;
@@ -18,8 +18,10 @@ use serde::Serialize;
 
 /// Secant stiffness drop that ends the initial loading.
 const LINEAR_DROP: f64 = 0.05;
-/// Share of the peak load below which readings do not define the initial stiffness.
+/// Share of the peak load where the initial line starts (below, toes and offsets).
 const FIRST_LOAD: f64 = 0.1;
+/// Share of the peak load where the initial line ends.
+const LINE_LOAD: f64 = 0.4;
 /// Load drop below the peak that ends the onset/peak regime.
 const PEAK_DROP: f64 = 0.05;
 /// Share of the post-peak displacement range counted as propagation; the rest is the late stage.
@@ -49,12 +51,18 @@ pub fn split(experiment: &str, x: &[f64], p: &[f64]) -> Vec<Regime> {
     }
     let end = x[n - 1];
     let peak = (0..n).max_by(|&a, &b| p[a].total_cmp(&p[b])).unwrap_or(0);
-    // Largest secant stiffness before the peak, over readings above 10 % of the peak load (the
-    // first readings' secants are mostly noise).
-    let secant = |i: usize| if x[i] > 0.0 && p[i] >= FIRST_LOAD * p[peak] { p[i] / x[i] } else { f64::NAN };
-    let k0 = (0..=peak).map(secant).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
-    let kmax_at = (0..=peak).find(|&i| secant(i) == k0).unwrap_or(0);
-    let linear_end = (kmax_at..=peak).find(|&i| secant(i) < (1.0 - LINEAR_DROP) * k0).unwrap_or(peak);
+    // The initial line: through the readings at 10 % and 40 % of the peak load (below 10 % a
+    // seating toe or a preload offset dominates). Linear loading lasts until the load falls
+    // below 95 % of that line for good (a single noisy reading does not end it).
+    let at = |share: f64| (0..=peak).find(|&i| p[i] >= share * p[peak]);
+    let linear_end = match (at(FIRST_LOAD), at(LINE_LOAD)) {
+        (Some(a), Some(b)) if x[b] > x[a] => {
+            let k0 = (p[b] - p[a]) / (x[b] - x[a]);
+            let below = |i: usize| p[i] < (1.0 - LINEAR_DROP) * (p[a] + k0 * (x[i] - x[a]));
+            (b..=peak).find(|&i| (i..=peak).all(below)).unwrap_or(peak)
+        }
+        _ => peak,
+    };
     let peak_end = (peak..n).find(|&i| p[i] < (1.0 - PEAK_DROP) * p[peak]);
     let mut bounds = vec![(NAMES[0], x[0], x[linear_end])];
     match peak_end {
