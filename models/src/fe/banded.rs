@@ -242,14 +242,123 @@ impl BandMatrix {
 
     /// Solves `A x = b` in place with the factors from [`BandMatrix::factorize`].
     pub fn solve_in_place(&self, b: &mut [f64]) {
-        let (n, bw, w) = (self.n, self.bw, self.width);
-        for i in 0..n {
+        match self.bw {
+            3 => self.solve_fixed::<3>(b),
+            5 => self.solve_fixed::<5>(b),
+            7 => self.solve_fixed::<7>(b),
+            11 => self.solve_fixed::<11>(b),
+            _ => self.solve_dyn(b),
+        }
+    }
+
+    /// Solves `A x = b1` and `A y = b2` in place together: the two substitution chains are
+    /// independent, so interleaving them hides most of their latency.
+    pub fn solve2_in_place(&self, b1: &mut [f64], b2: &mut [f64]) {
+        match self.bw {
+            3 => self.solve2_fixed::<3>(b1, b2),
+            5 => self.solve2_fixed::<5>(b1, b2),
+            7 => self.solve2_fixed::<7>(b1, b2),
+            11 => self.solve2_fixed::<11>(b1, b2),
+            _ => self.solve2_dyn(b1, b2),
+        }
+    }
+
+    /// The sub-diagonal part of row `i` (`BW` entries) for `i ≥ BW`.
+    #[inline(always)]
+    fn lower<const BW: usize>(&self, i: usize) -> &[f64; BW] {
+        let w = 2 * BW + 1;
+        self.data[i * w..i * w + BW].try_into().unwrap()
+    }
+
+    /// The super-diagonal part of row `i` (`BW` entries) for `i + BW < n`.
+    #[inline(always)]
+    fn upper<const BW: usize>(&self, i: usize) -> &[f64; BW] {
+        let w = 2 * BW + 1;
+        self.data[i * w + BW + 1..(i + 1) * w].try_into().unwrap()
+    }
+
+    /// [`BandMatrix::solve_in_place`] with a fixed half-bandwidth: the rows whose band lies inside
+    /// the matrix with fixed-length sums (the same sums in the same order as
+    /// [`BandMatrix::solve_dyn`]), the others as there.
+    fn solve_fixed<const BW: usize>(&self, b: &mut [f64]) {
+        let n = self.n;
+        if n <= 2 * BW {
+            return self.solve_dyn(b);
+        }
+        self.forward_rows(0..BW, b);
+        for i in BW..n {
+            let l = self.lower::<BW>(i);
+            let x: &[f64; BW] = b[i - BW..i].try_into().unwrap();
+            let mut s = 0.0;
+            for t in 0..BW {
+                s += l[t] * x[t];
+            }
+            b[i] -= s;
+        }
+        self.backward_rows(n - BW..n, b);
+        for i in (0..n - BW).rev() {
+            let u = self.upper::<BW>(i);
+            let x: &[f64; BW] = b[i + 1..i + 1 + BW].try_into().unwrap();
+            let mut s = 0.0;
+            for t in 0..BW {
+                s += u[t] * x[t];
+            }
+            b[i] = (b[i] - s) * self.inv_pivot[i];
+        }
+    }
+
+    /// [`BandMatrix::solve2_in_place`] with a fixed half-bandwidth (see
+    /// [`BandMatrix::solve_fixed`]).
+    fn solve2_fixed<const BW: usize>(&self, b1: &mut [f64], b2: &mut [f64]) {
+        let n = self.n;
+        if n <= 2 * BW {
+            return self.solve2_dyn(b1, b2);
+        }
+        self.forward_rows(0..BW, b1);
+        self.forward_rows(0..BW, b2);
+        for i in BW..n {
+            let l = self.lower::<BW>(i);
+            let x1: &[f64; BW] = b1[i - BW..i].try_into().unwrap();
+            let x2: &[f64; BW] = b2[i - BW..i].try_into().unwrap();
+            let (mut s1, mut s2) = (0.0, 0.0);
+            for t in 0..BW {
+                s1 += l[t] * x1[t];
+                s2 += l[t] * x2[t];
+            }
+            b1[i] -= s1;
+            b2[i] -= s2;
+        }
+        self.backward_rows(n - BW..n, b1);
+        self.backward_rows(n - BW..n, b2);
+        for i in (0..n - BW).rev() {
+            let u = self.upper::<BW>(i);
+            let x1: &[f64; BW] = b1[i + 1..i + 1 + BW].try_into().unwrap();
+            let x2: &[f64; BW] = b2[i + 1..i + 1 + BW].try_into().unwrap();
+            let (mut s1, mut s2) = (0.0, 0.0);
+            for t in 0..BW {
+                s1 += u[t] * x1[t];
+                s2 += u[t] * x2[t];
+            }
+            b1[i] = (b1[i] - s1) * self.inv_pivot[i];
+            b2[i] = (b2[i] - s2) * self.inv_pivot[i];
+        }
+    }
+
+    /// Forward substitution over `rows` (in order).
+    fn forward_rows(&self, rows: std::ops::Range<usize>, b: &mut [f64]) {
+        let (bw, w) = (self.bw, self.width);
+        for i in rows {
             let lo = i.saturating_sub(bw);
             let l = &self.data[i * w + lo + bw - i..i * w + bw];
             let s: f64 = l.iter().zip(&b[lo..i]).map(|(a, x)| a * x).sum();
             b[i] -= s;
         }
-        for i in (0..n).rev() {
+    }
+
+    /// Back substitution over `rows` (in reverse order).
+    fn backward_rows(&self, rows: std::ops::Range<usize>, b: &mut [f64]) {
+        let (n, bw, w) = (self.n, self.bw, self.width);
+        for i in rows.rev() {
             let hi = (i + bw).min(n - 1);
             let u = &self.data[i * w + bw + 1..i * w + bw + 1 + (hi - i)];
             let s: f64 = u.iter().zip(&b[i + 1..=hi]).map(|(a, x)| a * x).sum();
@@ -257,9 +366,14 @@ impl BandMatrix {
         }
     }
 
-    /// Solves `A x = b1` and `A y = b2` in place together: the two substitution chains are
-    /// independent, so interleaving them hides most of their latency.
-    pub fn solve2_in_place(&self, b1: &mut [f64], b2: &mut [f64]) {
+    /// [`BandMatrix::solve_in_place`] for any half-bandwidth.
+    fn solve_dyn(&self, b: &mut [f64]) {
+        self.forward_rows(0..self.n, b);
+        self.backward_rows(0..self.n, b);
+    }
+
+    /// [`BandMatrix::solve2_in_place`] for any half-bandwidth.
+    fn solve2_dyn(&self, b1: &mut [f64], b2: &mut [f64]) {
         let (n, bw, w) = (self.n, self.bw, self.width);
         for i in 0..n {
             let lo = i.saturating_sub(bw);
@@ -282,6 +396,97 @@ impl BandMatrix {
             }
             b1[i] = (b1[i] - s1) * self.inv_pivot[i];
             b2[i] = (b2[i] - s2) * self.inv_pivot[i];
+        }
+    }
+}
+
+/// The non-zero entries of a matrix by rows, in column order: its product with a vector skips
+/// the band's zeros, with the same sums as [`BandMatrix::mul_vec`] (a zero entry adds nothing).
+#[derive(Clone, Debug)]
+pub struct RowSparse {
+    /// Row `i`'s entries are `start[i]..start[i + 1]`.
+    start: Vec<usize>,
+    cols: Vec<usize>,
+    vals: Vec<f64>,
+}
+
+impl RowSparse {
+    /// The non-zero entries of `a`.
+    pub fn from_band(a: &BandMatrix) -> Self {
+        let mut r = RowSparse { start: vec![0], cols: Vec::new(), vals: Vec::new() };
+        for i in 0..a.n {
+            let (lo, hi) = (i.saturating_sub(a.bw), (i + a.bw).min(a.n - 1));
+            for j in lo..=hi {
+                let v = a.get(i, j);
+                if v != 0.0 {
+                    r.cols.push(j);
+                    r.vals.push(v);
+                }
+            }
+            r.start.push(r.cols.len());
+        }
+        r
+    }
+
+    /// `y = A x`.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        for (yi, w) in y.iter_mut().zip(self.start.windows(2)) {
+            let mut s = 0.0;
+            for (v, &j) in self.vals[w[0]..w[1]].iter().zip(&self.cols[w[0]..w[1]]) {
+                s += v * x[j];
+            }
+            *yi = s;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A diagonally dominant band matrix with some zeros in the band.
+    fn matrix(n: usize, bw: usize) -> BandMatrix {
+        let mut a = BandMatrix::zeros(n, bw);
+        for i in 0..n {
+            for j in i.saturating_sub(bw)..=(i + bw).min(n - 1) {
+                let v = if i == j { 10.0 * bw as f64 } else { ((i * 7 + j * 3) % 11) as f64 / 7.0 - 0.6 };
+                if (i + 2 * j) % 5 != 0 || i == j {
+                    a.add(i, j, v);
+                }
+            }
+        }
+        a
+    }
+
+    #[test]
+    fn fixed_bandwidth_paths_give_the_general_results() {
+        for (n, bw) in [(60, 3), (61, 5), (45, 7), (70, 11), (23, 11), (40, 4)] {
+            let a = matrix(n, bw);
+            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+            let mut y = vec![0.0; n];
+            let mut y_rows = vec![0.0; n];
+            a.mul_vec(&x, &mut y);
+            a.mul_vec_rows(0..n, &x, &mut y_rows);
+            assert_eq!(y, y_rows);
+            let mut y_sparse = vec![0.0; n];
+            RowSparse::from_band(&a).mul_vec(&x, &mut y_sparse);
+            assert_eq!(y, y_sparse);
+            let mut lu = a.clone();
+            lu.factorize().unwrap();
+            let (mut b1, mut b2) = (y.clone(), x.clone());
+            lu.solve2_in_place(&mut b1, &mut b2);
+            let (mut c1, mut c2) = (y.clone(), x.clone());
+            lu.solve2_dyn(&mut c1, &mut c2);
+            assert_eq!((&b1, &b2), (&c1, &c2));
+            let mut d = y.clone();
+            lu.solve_in_place(&mut d);
+            let mut e = y.clone();
+            lu.solve_dyn(&mut e);
+            assert_eq!(d, e);
+            assert_eq!(b1, d);
+            for (xi, di) in x.iter().zip(&d) {
+                assert!((xi - di).abs() < 1e-12, "{xi} {di}");
+            }
         }
     }
 }

@@ -46,7 +46,7 @@
 use czid_core::{CohesiveLaw, CzError, Gap, LawEval, LawState, Tangent, Traction};
 
 use super::assembly::{loading_tangent, strengths, Spring};
-use super::banded::BandMatrix;
+use super::banded::{BandMatrix, RowSparse};
 use super::beam;
 use super::crack::{self, CrackMeasures};
 use super::energy::path_work;
@@ -227,6 +227,8 @@ struct Solver<'a> {
     /// The fibres of each section of each fibre layer, their materials prepared.
     prepared: Vec<Vec<Vec<fibre::PreparedFibre>>>,
     linear: BandMatrix,
+    /// The non-zero entries of `linear`, for its product with the unknowns.
+    linear_rows: RowSparse,
     k: BandMatrix,
     f: Vec<f64>,
     fixed_mask: Vec<bool>,
@@ -403,6 +405,7 @@ impl<'a> Solver<'a> {
             fibre_elements,
             prepared: p.fibre_layers.iter().map(|fl| fl.sections.iter().map(|sec| sec.prepared()).collect()).collect(),
             k: BandMatrix::zeros(n, mesh.bandwidth()),
+            linear_rows: RowSparse::from_band(&linear),
             linear,
             f: vec![0.0; n],
             fixed_mask,
@@ -432,7 +435,7 @@ impl<'a> Solver<'a> {
     fn assemble(&mut self, c: &History, q: &[f64], secant: bool) -> bool {
         self.stats.assemblies += 1;
         let p = self.p;
-        self.linear.mul_vec(q, &mut self.f);
+        self.linear_rows.mul_vec(q, &mut self.f);
         let mut ok = true;
         for (ie, fe) in self.fibre_elements.iter().enumerate() {
             let fibres = &self.prepared[fe.fl][fe.section];
