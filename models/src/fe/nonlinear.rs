@@ -207,6 +207,18 @@ struct FibreElement {
     first: usize,
 }
 
+/// The linear layers' and the fibres' part of an assembly: their forces `f` at the unknowns `q`
+/// with secant stiffnesses or not; `valid` while the committed history is that of the assembly and
+/// no fibre has taken its unloading stiffness since.
+#[derive(Default)]
+struct Base {
+    valid: bool,
+    secant: bool,
+    ok: bool,
+    q: Vec<f64>,
+    f: Vec<f64>,
+}
+
 /// Committed or trial state of everything with history.
 #[derive(Clone)]
 struct History {
@@ -243,6 +255,8 @@ struct Solver<'a> {
     load: Vec<f64>,
     /// Work vectors of the Newton iterations.
     work: Vec<Vec<f64>>,
+    /// The linear layers' and fibres' part of the last assembly.
+    base: Base,
     settings: NewtonSettings,
     stats: NonlinearStats,
     with_compliance: bool,
@@ -416,6 +430,7 @@ impl<'a> Solver<'a> {
             kinematics,
             load,
             work: Vec::new(),
+            base: Base::default(),
             settings,
             stats: NonlinearStats::default(),
             with_compliance: p.compliance != [0.0, 0.0],
@@ -434,9 +449,15 @@ impl<'a> Solver<'a> {
     /// series-compliance solve failed).
     fn assemble(&mut self, c: &History, q: &[f64], secant: bool) -> bool {
         self.stats.assemblies += 1;
-        let p = self.p;
+        // Again at the unknowns of the last assembly (after a correction of the normal statuses):
+        // the linear layers and the fibres give what they gave then.
+        if self.base.valid && self.base.secant == secant && self.base.q == q {
+            self.f.copy_from_slice(&self.base.f);
+            return self.assemble_interface(c, q, secant, self.base.ok);
+        }
         self.linear_rows.mul_vec(q, &mut self.f);
         let mut ok = true;
+        let mut unloading_changed = false;
         for (ie, fe) in self.fibre_elements.iter().enumerate() {
             let fibres = &self.prepared[fe.fl][fe.section];
             let mut qe = [0.0; 6];
@@ -485,6 +506,7 @@ impl<'a> Solver<'a> {
                 if loading != loading_flags[k] {
                     loading_flags[k] = loading;
                     flips[k] = flips[k].saturating_add(1);
+                    unloading_changed |= unloading[k] != (flips[k] >= 3);
                     unloading[k] = flips[k] >= 3;
                 }
             }
@@ -492,6 +514,21 @@ impl<'a> Solver<'a> {
             ok &= fibre::element_forces(fe.len, &r, &fe.dofs, &mut self.f);
             self.section_tangents[ie] = r.tangent;
         }
+        // A fibre that takes its unloading stiffness from now on changes the next tangent.
+        let base = &mut self.base;
+        base.valid = !unloading_changed;
+        base.secant = secant;
+        base.ok = ok;
+        base.q.clear();
+        base.q.extend_from_slice(q);
+        base.f.clear();
+        base.f.extend_from_slice(&self.f);
+        self.assemble_interface(c, q, secant, ok)
+    }
+
+    /// The interface points' part of [`Solver::assemble`], `ok` from the rest.
+    fn assemble_interface(&mut self, c: &History, q: &[f64], secant: bool, mut ok: bool) -> bool {
+        let p = self.p;
         let mut hess = [[[0.0; 8]; 8]; 2];
         for (ip, pt) in p.points.iter().enumerate() {
             let kin = interface::kinematics(&p.mesh, pt, q, false, &mut hess);
@@ -652,6 +689,8 @@ impl<'a> Solver<'a> {
     /// `q`, `load`; returns the iterations on success.
     fn solve(&mut self, c: &History, q: &mut [f64], load: &mut f64, c_target: Option<f64>) -> Option<usize> {
         // The work vectors are kept from one step to the next.
+        // A new committed history (or a new step from it).
+        self.base.valid = false;
         let mut work = std::mem::take(&mut self.work);
         work.resize_with(3, Vec::new);
         for v in work.iter_mut() {
