@@ -316,31 +316,40 @@ impl BandMatrix {
         }
         self.forward_rows(0..BW, b1);
         self.forward_rows(0..BW, b2);
+        // The two right-hand sides side by side, so each step of a sum works on both at once.
+        let mut xs: Vec<[f64; 2]> = b1.iter().zip(b2.iter()).map(|(a, b)| [*a, *b]).collect();
         for i in BW..n {
             let l = self.lower::<BW>(i);
-            let x1: &[f64; BW] = b1[i - BW..i].try_into().unwrap();
-            let x2: &[f64; BW] = b2[i - BW..i].try_into().unwrap();
-            let (mut s1, mut s2) = (0.0, 0.0);
+            let x: &[[f64; 2]; BW] = xs[i - BW..i].try_into().unwrap();
+            let mut s = [0.0, 0.0];
             for t in 0..BW {
-                s1 += l[t] * x1[t];
-                s2 += l[t] * x2[t];
+                s[0] += l[t] * x[t][0];
+                s[1] += l[t] * x[t][1];
             }
-            b1[i] -= s1;
-            b2[i] -= s2;
+            xs[i][0] -= s[0];
+            xs[i][1] -= s[1];
+        }
+        for (i, x) in xs.iter().enumerate().skip(n - BW) {
+            [b1[i], b2[i]] = *x;
         }
         self.backward_rows(n - BW..n, b1);
         self.backward_rows(n - BW..n, b2);
+        for (i, x) in xs.iter_mut().enumerate().skip(n - BW) {
+            *x = [b1[i], b2[i]];
+        }
         for i in (0..n - BW).rev() {
             let u = self.upper::<BW>(i);
-            let x1: &[f64; BW] = b1[i + 1..i + 1 + BW].try_into().unwrap();
-            let x2: &[f64; BW] = b2[i + 1..i + 1 + BW].try_into().unwrap();
-            let (mut s1, mut s2) = (0.0, 0.0);
+            let x: &[[f64; 2]; BW] = xs[i + 1..i + 1 + BW].try_into().unwrap();
+            let mut s = [0.0, 0.0];
             for t in 0..BW {
-                s1 += u[t] * x1[t];
-                s2 += u[t] * x2[t];
+                s[0] += u[t] * x[t][0];
+                s[1] += u[t] * x[t][1];
             }
-            b1[i] = (b1[i] - s1) * self.inv_pivot[i];
-            b2[i] = (b2[i] - s2) * self.inv_pivot[i];
+            let p = self.inv_pivot[i];
+            xs[i] = [(xs[i][0] - s[0]) * p, (xs[i][1] - s[1]) * p];
+        }
+        for ((a, b), x) in b1.iter_mut().zip(b2.iter_mut()).zip(&xs) {
+            [*a, *b] = *x;
         }
     }
 
