@@ -166,18 +166,21 @@ impl ControlSettings {
     }
 }
 
-/// Standard columns of a beam test record.
+/// The standard columns of a beam test record, with their units.
+pub const COLUMNS: [(&str, &str); 8] = [
+    (columns::DISPLACEMENT, "mm"),
+    (columns::LOAD, "N"),
+    (columns::DEBONDED_LENGTH, "mm"),
+    (columns::PROCESS_ZONE_LENGTH, "mm"),
+    (columns::CRACK_TIP, "mm"),
+    (columns::EXTERNAL_WORK, "N·mm"),
+    (columns::ELASTIC_ENERGY, "N·mm"),
+    (columns::DISSIPATED_ENERGY, "N·mm"),
+];
+
+/// An empty record with the standard columns of a beam test.
 pub fn new_record() -> Record {
-    Record::new(&[
-        (columns::DISPLACEMENT, "mm"),
-        (columns::LOAD, "N"),
-        (columns::DEBONDED_LENGTH, "mm"),
-        (columns::PROCESS_ZONE_LENGTH, "mm"),
-        (columns::CRACK_TIP, "mm"),
-        (columns::EXTERNAL_WORK, "N·mm"),
-        (columns::ELASTIC_ENERGY, "N·mm"),
-        (columns::DISSIPATED_ENERGY, "N·mm"),
-    ])
+    Record::new(&COLUMNS)
 }
 
 /// How engine rows map to the specimen's record.

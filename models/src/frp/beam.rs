@@ -71,7 +71,7 @@
 //! `soffit_elongation` (mm, the control).
 
 use czid_core::error::require_positive;
-use czid_core::{columns, CohesiveLaw, CzError, ForwardModel, Record, Result, SimulationFailure};
+use czid_core::{CohesiveLaw, CzError, ForwardModel, Record, Result, SimulationFailure};
 use serde::{Deserialize, Serialize};
 
 use super::beam_effects::BeamEffects;
@@ -663,21 +663,15 @@ impl FrpBeam {
 }
 
 fn new_record() -> Record {
-    Record::new(&[
-        (columns::DISPLACEMENT, "mm"),
-        (columns::LOAD, "N"),
-        (columns::DEBONDED_LENGTH, "mm"),
-        (columns::PROCESS_ZONE_LENGTH, "mm"),
-        (columns::CRACK_TIP, "mm"),
-        (columns::EXTERNAL_WORK, "N·mm"),
-        (columns::ELASTIC_ENERGY, "N·mm"),
-        (columns::DISSIPATED_ENERGY, "N·mm"),
+    let mut columns = crate::beamtest::COLUMNS.to_vec();
+    columns.extend([
         (beam_columns::MIDSPAN_MOMENT, "N·mm"),
         (beam_columns::LOAD_POINT_DEFLECTION, "mm"),
         (beam_columns::SOFFIT_ELONGATION, "mm"),
         (beam_columns::INTERFACE_DISSIPATION, "N·mm"),
         (beam_columns::MATERIAL_DISSIPATION, "N·mm"),
-    ])
+    ]);
+    Record::new(&columns)
 }
 
 /// The plate's state at a snapshot.
