@@ -289,46 +289,6 @@ impl FibreSection {
             })
             .collect()
     }
-
-    /// Section forces and tangent at `e` from the committed `states` (one per fibre); the trial
-    /// states and stresses go to `trial` and `stress`. With `secant`, each fibre contributes its
-    /// secant stiffness `σ/ε` (non-negative for these materials under monotonic loading) instead
-    /// of its tangent: an iteration matrix that cannot cycle between loading and unloading. A
-    /// fibre `k` with `unloading[k]` set contributes its unloading stiffness
-    /// ([`FibreMaterial::unloading_stiffness`]) instead.
-    pub fn respond(
-        &self,
-        e: [f64; 2],
-        states: &[UniaxialState],
-        trial: &mut [UniaxialState],
-        stress: &mut [f64],
-        secant: bool,
-        unloading: &[bool],
-    ) -> SectionResponse {
-        let mut r = SectionResponse::default();
-        for (k, f) in self.fibres.iter().enumerate() {
-            let mat = &self.materials[f.material];
-            let mech = self.strain(f, e);
-            let res = mat.respond(mech, &states[k]);
-            trial[k] = res.state;
-            stress[k] = res.stress;
-            let stiffness = if unloading.get(k).copied().unwrap_or(false) {
-                mat.unloading_stiffness(mech, res.stress)
-            } else if secant && mech.abs() > 1e-12 {
-                (res.stress / mech).max(0.0)
-            } else {
-                res.tangent
-            };
-            let (fa, ka) = (res.stress * f.area, stiffness * f.area);
-            r.force[0] += fa;
-            r.force[1] -= fa * f.z;
-            r.tangent[0][0] += ka;
-            r.tangent[0][1] -= ka * f.z;
-            r.tangent[1][1] += ka * f.z * f.z;
-        }
-        r.tangent[1][0] = r.tangent[0][1];
-        r
-    }
 }
 
 /// Generalised strains `[ε, κ]` of an element of length `l` with nodal `[u1, w1, θ1, u2, w2, θ2]`.

@@ -474,8 +474,10 @@ impl<'a> Solver<'a> {
             let loading_flags = &mut self.fibre_loading[range.clone()];
             let flips = &mut self.fibre_flips[range.clone()];
             let unloading = &mut self.fibre_unloading[range];
-            // The section response (`FibreSection::respond`) and the fibres' bookkeeping in one
-            // pass over the fibres.
+            // The section response and the fibres' bookkeeping in one pass over the fibres: with
+            // `secant`, each fibre contributes its secant stiffness `σ/ε` (an iteration matrix that
+            // cannot cycle between loading and unloading); a fibre flagged as unloading, its
+            // unloading stiffness.
             let mut r = fibre::SectionResponse::default();
             for (k, f) in fibres.iter().enumerate() {
                 let mat = &f.material;
