@@ -1,10 +1,11 @@
 //! `gap-bench`: the diagnosis checked on cases whose answer is known.
 //!
-//! Each planted case is a synthetic DCB test (Hartlen's specimen geometry, a triangular law, a
-//! random modulus, strength and toughness, random load and crack-length noise) made with one
-//! candidate effect switched on at a random realistic size, then diagnosed with the base model,
-//! which does not know it. Null cases have no effect. The answer of a case is the best-scoring
-//! candidate when it is significant, else "none".
+//! Each planted case is a synthetic DCB test made like the bundled real ones (Hartlen's specimen
+//! geometry, as many readings and as far an opening as those tests, noise from half to three
+//! times theirs; a triangular law and arm modulus drawn at random) with one candidate effect
+//! switched on at a random realistic size, then diagnosed with the base model, which does not
+//! know it. Null cases have no effect. The answer of a case is the best-scoring candidate when it
+//! is significant, else "none".
 
 use crate::data::Experiment;
 use crate::diagnose::candidate::Library;
@@ -23,10 +24,15 @@ use std::collections::BTreeMap;
 
 /// Label of a case with no effect, and of a diagnosis that names none.
 pub const NONE: &str = "none";
-/// Readings per synthetic curve.
-const READINGS: usize = 120;
-/// Final opening of the synthetic tests (mm).
-const OPENING: f64 = 30.0;
+/// Readings per synthetic curve: the bundled real DCB tests have 325 to 456.
+const READINGS: std::ops::Range<usize> = 320..460;
+/// Final opening of the synthetic tests (mm): the bundled real DCB tests end at 26.7 to 36.9 mm.
+const OPENING: std::ops::Range<f64> = 26.0..38.0;
+/// Load noise (N): the bundled real tests scatter by about 0.2 N from reading to reading.
+const LOAD_NOISE: std::ops::Range<f64> = 0.1..0.6;
+/// Crack-length noise (mm): their crack lengths scatter by about 0.1 mm, but a crack read by eye
+/// on the specimen's edge is rarely better than a few tenths of a millimetre.
+const LENGTH_NOISE: std::ops::Range<f64> = 0.2..0.8;
 /// Mean cosine (beyond the fitted parameters) above which a pair of effects is predicted to be
 /// confusable.
 pub const CONFUSABLE: f64 = 0.9;
@@ -76,6 +82,10 @@ pub struct CaseResult {
     pub truth: [f64; 3],
     /// Load (N) and crack-length (mm) noise.
     pub noise: [f64; 2],
+    /// Readings of the synthetic test.
+    pub readings: usize,
+    /// Its final opening (mm).
+    pub opening: f64,
     /// Diagnosed effect ([`NONE`] when no candidate is significant).
     pub diagnosed: String,
     /// Candidates by score, best first, with whether they are significant.
@@ -131,9 +141,9 @@ pub struct BenchReport {
     pub wall_seconds: f64,
 }
 
-fn base_dcb() -> Dcb {
+fn base_dcb(opening: f64) -> Dcb {
     let mut d = Dcb::hartlen_dcb01();
-    d.control.max_displacement = Some(OPENING);
+    d.control.max_displacement = Some(opening);
     d
 }
 
@@ -148,10 +158,10 @@ pub fn space() -> ParameterSpace {
 }
 
 /// The benchmark's base model: Hartlen's DCB with a triangular law of strength `truth[0]` (MPa)
-/// and toughness `truth[1]` (N/mm), arms of modulus `truth[2]` (MPa).
-fn base_setup(truth: &[f64; 3]) -> Result<Setup> {
+/// and toughness `truth[1]` (N/mm), arms of modulus `truth[2]` (MPa), opened to `opening` mm.
+fn base_setup(truth: &[f64; 3], opening: f64) -> Result<Setup> {
     let law: Box<dyn CohesiveLaw> = Box::new(Bilinear::bk(1e5, truth[0], truth[0], truth[1], 2.0, 2.0)?);
-    let mut dcb = base_dcb();
+    let mut dcb = base_dcb(opening);
     dcb.material.e11 = truth[2];
     let models: BTreeMap<String, Box<dyn ForwardModel>> =
         [("dcb".to_string(), Box::new(dcb) as Box<dyn ForwardModel>)].into();
@@ -162,7 +172,9 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
     let clock = std::time::Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
     let truth = [rng.random_range(20.0..45.0), rng.random_range(0.5..1.2), rng.random_range(16_000.0..30_000.0)];
-    let noise = [rng.random_range(0.2..1.0), rng.random_range(0.2..0.8)];
+    let noise = [rng.random_range(LOAD_NOISE), rng.random_range(LENGTH_NOISE)];
+    let readings = rng.random_range(READINGS);
+    let opening = rng.random_range(OPENING);
     let mut size = if planted == NONE { Vec::new() } else { plant(planted, &mut rng).unwrap_or_default() };
     let jitter: Vec<f64> = (0..3).map(|_| rng.random_range(-0.05..0.05)).collect();
     let noise_seed: u64 = rng.random();
@@ -172,6 +184,8 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         size: size.clone(),
         truth,
         noise,
+        readings,
+        opening,
         diagnosed: NONE.into(),
         ranking: Vec::new(),
         base_reduced_chi2: f64::NAN,
@@ -186,7 +200,7 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         error: None,
     };
     let mut run = || -> Result<()> {
-        let base = base_setup(&truth)?;
+        let base = base_setup(&truth, opening)?;
         // A planted model that stops early is drawn again (a few times), and counted.
         let mut attempt = 0;
         let record = loop {
@@ -210,8 +224,8 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         };
         let data = synthesize(
             &record,
-            READINGS,
-            Some(OPENING),
+            readings,
+            Some(opening),
             &Noise { load_sd: noise[0], length_sd: noise[1], seed: noise_seed },
         )?;
         let experiment = Experiment {
@@ -270,7 +284,7 @@ pub fn run(opts: &BenchOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Res
     let clock = std::time::Instant::now();
     let library = Library::builtin();
     // Every candidate that applies to the benchmark's DCB and that it knows how to plant.
-    let sample = base_setup(&[30.0, 0.8, 20_000.0])?;
+    let sample = base_setup(&[30.0, 0.8, 20_000.0], OPENING.start)?;
     let known = |name: &str| plant(name, &mut ChaCha8Rng::seed_from_u64(0)).is_some();
     let effects: Vec<String> = if opts.effects.is_empty() {
         library
