@@ -2,10 +2,11 @@
 //!
 //! ```text
 //! czid gap-bench --cases 20 --nulls 20 --seed 1 --out out/gap-bench
+//! czid gap-bench --family beam --cases 20 --out out/gap-bench-beam
 //! ```
 
 use czid_core::CzError;
-use czid_problems::diagnose::bench::{self, BenchOptions};
+use czid_problems::diagnose::bench::{self, BenchOptions, CaseStore, Family};
 use czid_problems::output::OutputDir;
 use std::path::PathBuf;
 
@@ -21,15 +22,21 @@ pub struct GapBenchArgs {
     /// Seed of the benchmark.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Effects to plant, comma separated (default: every bundled candidate).
+    /// Effects to plant, comma separated (default: every bundled candidate of the family).
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
-    /// Output folder (bench.json, bench.md).
+    /// Synthetic tests: `dcb` (Hartlen's specimens) or `beam` (the paper's FRP-strengthened beam).
+    #[arg(long, default_value = "dcb")]
+    pub family: String,
+    /// Output folder (bench.json, bench.md, and each finished case in cases/).
     #[arg(long)]
     pub out: PathBuf,
-    /// Overwrite results already in the output folder.
-    #[arg(long)]
+    /// Overwrite results already in the output folder (every case is run again).
+    #[arg(long, conflicts_with = "resume")]
     pub force: bool,
+    /// Continue an interrupted run in the same folder: cases already finished are reused.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 /// Runs the benchmark and writes `bench.json` and `bench.md`.
@@ -39,15 +46,17 @@ pub fn run(args: &GapBenchArgs) -> Result<(), CzError> {
         nulls: args.nulls.unwrap_or(args.cases),
         seed: args.seed,
         effects: args.effects.clone(),
+        family: args.family.parse::<Family>()?,
     };
-    let dir = OutputDir::create(&args.out, args.force, false)?;
+    let dir = OutputDir::create(&args.out, args.force, args.resume)?;
+    let store = CaseStore { dir: OutputDir::create(&dir.file("cases"), true, true)?, reuse: args.resume };
     let bar = indicatif::ProgressBar::new(0);
     if let Ok(style) =
         indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} cases  eta {eta}")
     {
         bar.set_style(style.progress_chars("=> "));
     }
-    let report = bench::run(&opts, &|done, total| {
+    let report = bench::run(&opts, Some(&store), &|done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     })?;

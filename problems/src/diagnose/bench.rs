@@ -1,38 +1,30 @@
 //! `gap-bench`: the diagnosis checked on cases whose answer is known.
 //!
-//! Each planted case is a synthetic DCB test made like the bundled real ones (Hartlen's specimen
-//! geometry, as many readings and as far an opening as those tests, noise from half to three
-//! times theirs; a triangular law and arm modulus drawn at random) with one candidate effect
-//! switched on at a random realistic size, then diagnosed with the base model, which does not
-//! know it. Null cases have no effect. The answer of a case is the best-scoring candidate when it
-//! is significant, else "none".
+//! Each planted case is a synthetic test of a [`Family`] (a DCB made like the bundled real ones,
+//! or the paper's FRP-strengthened beam) with one candidate effect switched on at a random
+//! realistic size, then diagnosed with the base model, which does not know it. Null cases have no
+//! effect. The answer of a case is the best-scoring candidate when it is significant, else
+//! "none". Each finished case can be kept in a folder, so that an interrupted run resumes.
+
+mod family;
+
+pub use family::{Family, TestDraw};
 
 use crate::data::Experiment;
 use crate::diagnose::candidate::Library;
 use crate::diagnose::run::{diagnose_subject, Options, Subject};
 use crate::diagnose::stats::chi2_survival;
-use crate::identification::Setup;
+use crate::output::OutputDir;
 use crate::synthetic::{synthesize, Noise};
-use czid_core::{CohesiveLaw, Curve, CzError, ForwardModel, Parameter, ParameterSpace, Result};
-use czid_models::dcb::Dcb;
-use czid_models::laws::Bilinear;
+use czid_core::{columns, Curve, CzError, Result};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// Label of a case with no effect, and of a diagnosis that names none.
 pub const NONE: &str = "none";
-/// Readings per synthetic curve: the bundled real DCB tests have 325 to 456.
-const READINGS: std::ops::Range<usize> = 320..460;
-/// Final opening of the synthetic tests (mm): the bundled real DCB tests end at 26.7 to 36.9 mm.
-const OPENING: std::ops::Range<f64> = 26.0..38.0;
-/// Load noise (N): the bundled real tests scatter by about 0.2 N from reading to reading.
-const LOAD_NOISE: std::ops::Range<f64> = 0.1..0.6;
-/// Crack-length noise (mm): their crack lengths scatter by about 0.1 mm, but a crack read by eye
-/// on the specimen's edge is rarely better than a few tenths of a millimetre.
-const LENGTH_NOISE: std::ops::Range<f64> = 0.2..0.8;
 /// Mean cosine (beyond the fitted parameters) above which a pair of effects is predicted to be
 /// confusable.
 pub const CONFUSABLE: f64 = 0.9;
@@ -46,31 +38,14 @@ pub struct BenchOptions {
     pub nulls: usize,
     /// Seed of the whole benchmark (cases are reproducible one by one).
     pub seed: u64,
-    /// Effects to plant (empty: every bundled one).
+    /// Effects to plant (empty: every bundled one that applies to the family).
     pub effects: Vec<String>,
-}
-
-/// A planted effect at a realistic size: `(values per parameter)` drawn for the candidate.
-fn plant(name: &str, rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
-    let sign = |rng: &mut ChaCha8Rng| if rng.random::<bool>() { 1.0 } else { -1.0 };
-    Some(match name {
-        // Bridging tails of 0.3–1.5 MPa over 0.5–2 mm openings: 0.1–1.5 N/mm of extra toughness.
-        "fibre_bridging" => vec![rng.random_range(0.3..1.5), rng.random_range(0.5..2.0)],
-        "large_rotation" => vec![1.0],
-        // 0.5–2 × h/(2 E22) for the specimen's arms (2.2e-4 mm/MPa).
-        "root_compliance" => vec![rng.random_range(1.1e-4..4.4e-4)],
-        // 2–8 mm/kN: a light load train, 5–20 % of the specimen's initial compliance.
-        "machine_compliance" => vec![rng.random_range(2e-3..8e-3)],
-        "crack_length_offset" => vec![sign(rng) * rng.random_range(1.0..4.0)],
-        "displacement_offset" => vec![sign(rng) * rng.random_range(0.2..0.8)],
-        // An effective G13 between 1/(1/G13 + 2e-4) and 1/(1/G13 + 8e-4): 30–65 % of nominal.
-        "shear_compliance" => vec![rng.random_range(2e-4..8e-4)],
-        _ => return None,
-    })
+    /// The synthetic tests.
+    pub family: Family,
 }
 
 /// One case's outcome.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseResult {
     /// Case index.
     pub index: usize,
@@ -78,13 +53,13 @@ pub struct CaseResult {
     pub planted: String,
     /// Its values (physical units, per parameter).
     pub size: Vec<f64>,
-    /// True strength (MPa), toughness (N/mm), modulus (MPa).
+    /// True values of the fitted parameters (physical units, in the order of [`Family::space`]).
     pub truth: [f64; 3],
     /// Load (N) and crack-length (mm) noise.
     pub noise: [f64; 2],
     /// Readings of the synthetic test.
     pub readings: usize,
-    /// Its final opening (mm).
+    /// Its final displacement (mm).
     pub opening: f64,
     /// Diagnosed effect ([`NONE`] when no candidate is significant).
     pub diagnosed: String,
@@ -141,41 +116,11 @@ pub struct BenchReport {
     pub wall_seconds: f64,
 }
 
-fn base_dcb(opening: f64) -> Dcb {
-    let mut d = Dcb::hartlen_dcb01();
-    d.control.max_displacement = Some(opening);
-    d
-}
-
-/// The fitted parameters of every case: as in the real-DCB problem files.
-pub fn space() -> ParameterSpace {
-    ParameterSpace::new(vec![
-        Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),
-        Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),
-        Parameter::new("models.*.material.e11", "MPa", 10_000.0, 50_000.0),
-    ])
-    .expect("valid bounds")
-}
-
-/// The benchmark's base model: Hartlen's DCB with a triangular law of strength `truth[0]` (MPa)
-/// and toughness `truth[1]` (N/mm), arms of modulus `truth[2]` (MPa), opened to `opening` mm.
-fn base_setup(truth: &[f64; 3], opening: f64) -> Result<Setup> {
-    let law: Box<dyn CohesiveLaw> = Box::new(Bilinear::bk(1e5, truth[0], truth[0], truth[1], 2.0, 2.0)?);
-    let mut dcb = base_dcb(opening);
-    dcb.material.e11 = truth[2];
-    let models: BTreeMap<String, Box<dyn ForwardModel>> =
-        [("dcb".to_string(), Box::new(dcb) as Box<dyn ForwardModel>)].into();
-    Ok(Setup { law, models })
-}
-
-fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult {
+fn case(index: usize, planted: &str, seed: u64, family: Family, library: &Library) -> CaseResult {
     let clock = std::time::Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
-    let truth = [rng.random_range(20.0..45.0), rng.random_range(0.5..1.2), rng.random_range(16_000.0..30_000.0)];
-    let noise = [rng.random_range(LOAD_NOISE), rng.random_range(LENGTH_NOISE)];
-    let readings = rng.random_range(READINGS);
-    let opening = rng.random_range(OPENING);
-    let mut size = if planted == NONE { Vec::new() } else { plant(planted, &mut rng).unwrap_or_default() };
+    let TestDraw { truth, noise, readings, end } = family.draw(&mut rng);
+    let mut size = if planted == NONE { Vec::new() } else { family.plant(planted, &mut rng).unwrap_or_default() };
     let jitter: Vec<f64> = (0..3).map(|_| rng.random_range(-0.05..0.05)).collect();
     let noise_seed: u64 = rng.random();
     let mut out = CaseResult {
@@ -185,7 +130,7 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         truth,
         noise,
         readings,
-        opening,
+        opening: end.unwrap_or(f64::NAN),
         diagnosed: NONE.into(),
         ranking: Vec::new(),
         base_reduced_chi2: f64::NAN,
@@ -200,7 +145,7 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
         error: None,
     };
     let mut run = || -> Result<()> {
-        let base = base_setup(&truth, opening)?;
+        let base = family.base_setup(&truth, end)?;
         // A planted model that stops early is drawn again (a few times), and counted.
         let mut attempt = 0;
         let record = loop {
@@ -210,31 +155,41 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
                 let c = library.select(&[planted.to_string()])?[0];
                 c.apply(&base, &size)?
             };
-            match true_setup.models["dcb"].simulate(true_setup.law.as_ref()) {
+            match true_setup.models[family.name()].simulate(true_setup.law.as_ref()) {
                 Ok(r) => break r,
                 Err(f) if attempt < 5 && planted != NONE => {
                     attempt += 1;
                     out.redraws = attempt;
-                    size = plant(planted, &mut rng).unwrap_or_default();
+                    size = family.plant(planted, &mut rng).unwrap_or_default();
                     out.size = size.clone();
                     let _ = f;
                 }
                 Err(f) => return Err(CzError::Simulation(format!("planted model: {f}"))),
             }
         };
+        // Without a set end the test ends at its peak load (a beam: IC debonding).
+        let end = match end {
+            Some(e) => e,
+            None => {
+                let load = record.curve(columns::DISPLACEMENT, columns::LOAD)?;
+                let peak = (0..load.len()).max_by(|&a, &b| load.y()[a].total_cmp(&load.y()[b])).unwrap_or(0);
+                load.x()[peak]
+            }
+        };
+        out.opening = end;
         let data = synthesize(
             &record,
             readings,
-            Some(opening),
+            Some(end),
             &Noise { load_sd: noise[0], length_sd: noise[1], seed: noise_seed },
         )?;
         let experiment = Experiment {
-            name: "dcb".into(),
+            name: family.name().into(),
             load: Curve::new(data.displacement.clone(), data.load)?,
             debonded_length: Some(Curve::new(data.displacement, data.debonded_length)?),
             initial_crack: None,
         };
-        let space = space();
+        let space = family.space();
         let u0: Vec<f64> = space.to_unit(&truth).iter().zip(&jitter).map(|(u, j)| (u + j).clamp(0.0, 1.0)).collect();
         let subject = Subject {
             name: format!("case {index}"),
@@ -279,13 +234,34 @@ fn case(index: usize, planted: &str, seed: u64, library: &Library) -> CaseResult
     out
 }
 
-/// Runs the benchmark; `progress(done, total)` is called as cases finish.
-pub fn run(opts: &BenchOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<BenchReport> {
+/// Where a finished case is kept: its file name in the store (family, seed, index and planted
+/// effect say which case it is).
+fn case_file(opts: &BenchOptions, index: usize, planted: &str) -> String {
+    format!("case-{}-seed{}-{index:04}-{planted}.json", opts.family.name(), opts.seed)
+}
+
+/// A folder where each finished case is written at once (atomically).
+pub struct CaseStore {
+    /// The folder.
+    pub dir: OutputDir,
+    /// Reuse the cases already there instead of running them again (resume an interrupted run).
+    pub reuse: bool,
+}
+
+/// Runs the benchmark; `progress(done, total)` is called as cases finish. With a `store`, each
+/// finished case is kept there, and with `store.reuse` a case already there is not run again:
+/// an interrupted benchmark resumes where it stopped.
+pub fn run(
+    opts: &BenchOptions,
+    store: Option<&CaseStore>,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<BenchReport> {
     let clock = std::time::Instant::now();
     let library = Library::builtin();
-    // Every candidate that applies to the benchmark's DCB and that it knows how to plant.
-    let sample = base_setup(&[30.0, 0.8, 20_000.0], OPENING.start)?;
-    let known = |name: &str| plant(name, &mut ChaCha8Rng::seed_from_u64(0)).is_some();
+    let family = opts.family;
+    // Every candidate that applies to the family's model and that it knows how to plant.
+    let sample = family.base_setup(&family.draw(&mut ChaCha8Rng::seed_from_u64(0)).truth, None)?;
+    let known = |name: &str| family.plant(name, &mut ChaCha8Rng::seed_from_u64(0)).is_some();
     let effects: Vec<String> = if opts.effects.is_empty() {
         library
             .all()
@@ -298,7 +274,7 @@ pub fn run(opts: &BenchOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Res
             if !c.applies(&sample) || !known(c.name()) {
                 return Err(CzError::config(
                     "--effects",
-                    format!("`{}` cannot be planted in the benchmark's DCB", c.name()),
+                    format!("`{}` cannot be planted in the {} benchmark", c.name(), family.name()),
                 ));
             }
         }
@@ -315,7 +291,20 @@ pub fn run(opts: &BenchOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Res
         .par_iter()
         .enumerate()
         .map(|(i, p)| {
-            let r = case(i, p, opts.seed, &library);
+            let file = case_file(opts, i, p);
+            let kept = store
+                .filter(|s| s.reuse)
+                .and_then(|s| std::fs::read_to_string(s.dir.file(&file)).ok())
+                .and_then(|text| serde_json::from_str::<CaseResult>(&text).ok())
+                .filter(|c| c.error.is_none());
+            let r = kept.unwrap_or_else(|| {
+                let r = case(i, p, opts.seed, family, &library);
+                if let (Some(s), Ok(json)) = (store, serde_json::to_string_pretty(&r)) {
+                    // Losing a kept case only costs its rerun.
+                    let _ = s.dir.write(&file, &json);
+                }
+                r
+            });
             progress(done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1, total);
             r
         })
@@ -380,8 +369,11 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# gap-bench: {} planted cases per effect, {} null cases, seed {}\n",
-        opts.cases, opts.nulls, opts.seed
+        "# gap-bench ({}): {} planted cases per effect, {} null cases, seed {}\n",
+        opts.family.name(),
+        opts.cases,
+        opts.nulls,
+        opts.seed
     );
     let _ = writeln!(s, "Confusion matrix (rows: planted, columns: diagnosed):\n");
     let _ = writeln!(s, "| planted \\ diagnosed | {} |", r.labels.join(" | "));

@@ -1,0 +1,180 @@
+//! The synthetic tests `gap-bench` plants its effects in.
+//!
+//! * [`Family::Dcb`]: DCB tests made like the bundled real ones (Hartlen's specimen geometry, as
+//!   many readings and as far an opening as those tests, noise from half to three times theirs),
+//!   a triangular law and arm modulus drawn at random.
+//! * [`Family::Beam`]: the paper's FRP-strengthened RC beam loaded to the peak (IC debonding),
+//!   an ST-CZM bond law of random shear strength and failure slip, a random concrete modulus, with
+//!   load-cell and debonded-length noise of beam tests.
+
+use crate::identification::Setup;
+use czid_core::{CohesiveLaw, CzError, ForwardModel, Parameter, ParameterSpace, Result};
+use czid_models::dcb::Dcb;
+use czid_models::frp::beam::FrpBeam;
+use czid_models::laws::{Bilinear, StCzm};
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+/// DCB readings per curve: the bundled real DCB tests have 325 to 456.
+const DCB_READINGS: Range<usize> = 320..460;
+/// DCB final opening (mm): the bundled real DCB tests end at 26.7 to 36.9 mm.
+const DCB_OPENING: Range<f64> = 26.0..38.0;
+/// DCB load noise (N): the bundled real tests scatter by about 0.2 N from reading to reading.
+const DCB_LOAD_NOISE: Range<f64> = 0.1..0.6;
+/// DCB crack-length noise (mm): their crack lengths scatter by about 0.1 mm, but a crack read by
+/// eye on the specimen's edge is rarely better than a few tenths of a millimetre.
+const DCB_LENGTH_NOISE: Range<f64> = 0.2..0.8;
+/// Beam readings up to the peak load.
+const BEAM_READINGS: Range<usize> = 150..400;
+/// Beam load noise (N): 0.1–0.6 % of a 250 kN peak, a load cell of 500 kN full scale.
+const BEAM_LOAD_NOISE: Range<f64> = 300.0..1500.0;
+/// Beam debonded-length noise (mm): strain gauges 50–100 mm apart along the plate, or the
+/// debonded zone read by tapping, locate the front to 5–20 mm.
+const BEAM_LENGTH_NOISE: Range<f64> = 5.0..20.0;
+
+/// A family of synthetic tests.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    /// DCB tests like Hartlen's.
+    Dcb,
+    /// The paper's FRP-strengthened beam.
+    Beam,
+}
+
+impl std::str::FromStr for Family {
+    type Err = CzError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "dcb" => Ok(Family::Dcb),
+            "beam" | "frp_beam" => Ok(Family::Beam),
+            other => Err(CzError::config("--family", format!("unknown family `{other}`; known families: dcb, beam"))),
+        }
+    }
+}
+
+/// One case's test: the true fitted parameters, noise, readings and end.
+#[derive(Clone, Debug)]
+pub struct TestDraw {
+    /// True values of the fitted parameters, in the order of [`Family::space`].
+    pub truth: [f64; 3],
+    /// Load (N) and debonded-length (mm) noise.
+    pub noise: [f64; 2],
+    /// Readings.
+    pub readings: usize,
+    /// Final displacement (mm); `None`: at the true model's peak load.
+    pub end: Option<f64>,
+}
+
+impl Family {
+    /// Name of the family, of its experiment and of its model in the setup.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Family::Dcb => "dcb",
+            Family::Beam => "beam",
+        }
+    }
+
+    /// The fitted parameters of every case.
+    pub fn space(&self) -> ParameterSpace {
+        let parameters = match self {
+            // As in the real-DCB problem files.
+            Family::Dcb => vec![
+                Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),
+                Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),
+                Parameter::new("models.*.material.e11", "MPa", 10_000.0, 50_000.0),
+            ],
+            // What the load and debonded length of a beam determine: the bond law's shear branch
+            // (IC debonding is a mode II failure) and the concrete's stiffness.
+            Family::Beam => vec![
+                Parameter::new("law.strength_t", "MPa", 5.0, 30.0),
+                Parameter::new("law.u_c_t", "mm", 0.06, 0.4),
+                Parameter::new("models.*.section.concrete.elastic_modulus", "MPa", 20_000.0, 45_000.0),
+            ],
+        };
+        ParameterSpace::new(parameters).expect("valid bounds")
+    }
+
+    /// Draws a case's test. The DCB draws are, in order: strength, toughness, modulus, load and
+    /// length noise, readings, opening (a benchmark's cases stay reproducible one by one).
+    pub fn draw(&self, rng: &mut ChaCha8Rng) -> TestDraw {
+        match self {
+            Family::Dcb => {
+                let truth =
+                    [rng.random_range(20.0..45.0), rng.random_range(0.5..1.2), rng.random_range(16_000.0..30_000.0)];
+                let noise = [rng.random_range(DCB_LOAD_NOISE), rng.random_range(DCB_LENGTH_NOISE)];
+                let readings = rng.random_range(DCB_READINGS);
+                let end = Some(rng.random_range(DCB_OPENING));
+                TestDraw { truth, noise, readings, end }
+            }
+            Family::Beam => {
+                // Around the paper's Table 8 law (14 MPa, 0.15 mm) and f'c = 47 MPa (32 GPa).
+                let truth =
+                    [rng.random_range(10.0..18.0), rng.random_range(0.10..0.20), rng.random_range(29_000.0..35_500.0)];
+                let noise = [rng.random_range(BEAM_LOAD_NOISE), rng.random_range(BEAM_LENGTH_NOISE)];
+                let readings = rng.random_range(BEAM_READINGS);
+                TestDraw { truth, noise, readings, end: None }
+            }
+        }
+    }
+
+    /// The base model at the true parameters `truth`, run to `end` mm (`None`: the model's own
+    /// end).
+    pub fn base_setup(&self, truth: &[f64; 3], end: Option<f64>) -> Result<Setup> {
+        let (law, model): (Box<dyn CohesiveLaw>, Box<dyn ForwardModel>) = match self {
+            Family::Dcb => {
+                let law = Bilinear::bk(1e5, truth[0], truth[0], truth[1], 2.0, 2.0)?;
+                let mut dcb = Dcb::hartlen_dcb01();
+                dcb.control.max_displacement = end;
+                dcb.material.e11 = truth[2];
+                (Box::new(law), Box::new(dcb))
+            }
+            Family::Beam => {
+                let t8 = FrpBeam::table8_law()?;
+                let law = StCzm::sawtooth(t8.strength_n, t8.u_e_n, t8.u_c_n, truth[0], t8.u_e_t, truth[1])?;
+                let mut beam = FrpBeam::paper()?;
+                beam.section.concrete.elastic_modulus = truth[2];
+                (Box::new(law), Box::new(beam))
+            }
+        };
+        let models: BTreeMap<String, Box<dyn ForwardModel>> = [(self.name().to_string(), model)].into();
+        Ok(Setup { law, models })
+    }
+
+    /// A planted effect at a realistic size: values per parameter of the candidate `name`, or
+    /// `None` when the family does not plant it.
+    pub fn plant(&self, name: &str, rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
+        let sign = |rng: &mut ChaCha8Rng| if rng.random::<bool>() { 1.0 } else { -1.0 };
+        Some(match (self, name) {
+            // Bridging tails of 0.3–1.5 MPa over 0.5–2 mm openings: 0.1–1.5 N/mm of extra toughness.
+            (Family::Dcb, "fibre_bridging") => vec![rng.random_range(0.3..1.5), rng.random_range(0.5..2.0)],
+            (Family::Dcb, "large_rotation") => vec![1.0],
+            // 0.5–2 × h/(2 E22) for the specimen's arms (2.2e-4 mm/MPa).
+            (Family::Dcb, "root_compliance") => vec![rng.random_range(1.1e-4..4.4e-4)],
+            // 2–8 mm/kN: a light load train, 5–20 % of the specimen's initial compliance.
+            (Family::Dcb, "machine_compliance") => vec![rng.random_range(2e-3..8e-3)],
+            (Family::Dcb, "crack_length_offset") => vec![sign(rng) * rng.random_range(1.0..4.0)],
+            (Family::Dcb, "displacement_offset") => vec![sign(rng) * rng.random_range(0.2..0.8)],
+            // An effective G13 between 1/(1/G13 + 2e-4) and 1/(1/G13 + 8e-4): 30–65 % of nominal.
+            (Family::Dcb, "shear_compliance") => vec![rng.random_range(2e-4..8e-4)],
+            // Adhesive 1–2 mm thick of shear modulus 2–5 GPa: t_a/G_a = 2e-4–1e-3 mm/MPa.
+            (Family::Beam, "adhesive_compliance") => vec![rng.random_range(2e-4..1e-3)],
+            // The same layer in peeling, E_a = 5–12 GPa: t_a/E_a = 1e-4–4e-4 mm/MPa.
+            (Family::Beam, "adhesive_normal_compliance") => vec![rng.random_range(1e-4..4e-4)],
+            // Drying shrinkage of the concrete after the plate was bonded: 100–300 µε.
+            (Family::Beam, "shrinkage_strain") => vec![-rng.random_range(1e-4..3e-4)],
+            // Bars hardening at 0.25–0.75 % or 1.25–2.25 % of E_s instead of the assumed 1 %.
+            (Family::Beam, "steel_hardening") => vec![sign(rng) * rng.random_range(500.0..1500.0)],
+            // Concrete fracture energy 15–35 % off the model code's 0.146 N/mm.
+            (Family::Beam, "concrete_softening") => vec![sign(rng) * rng.random_range(0.02..0.05)],
+            // Tensile strength 0.3–0.8 MPa off the 3.7 MPa estimated from f'c.
+            (Family::Beam, "concrete_cracking") => vec![sign(rng) * rng.random_range(0.3..0.8)],
+            // Seating of the supports and load points: 0.3–1.5 mm.
+            (Family::Beam, "deflection_offset") => vec![rng.random_range(0.3..1.5)],
+            _ => return None,
+        })
+    }
+}

@@ -1,0 +1,54 @@
+//! `gap-bench` bookkeeping: cases kept as they finish and reused when a run resumes, families
+//! named clearly, and the same case drawn whatever else is in the plan.
+
+use czid_problems::diagnose::bench::{self, BenchOptions, CaseStore, Family};
+use czid_problems::output::OutputDir;
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let p = std::env::temp_dir().join(format!("czid-gap-bench-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&p);
+    p
+}
+
+fn one_null() -> BenchOptions {
+    BenchOptions { cases: 0, nulls: 1, seed: 3, effects: Vec::new(), family: Family::Dcb }
+}
+
+#[test]
+fn a_resumed_run_reuses_the_cases_already_finished() {
+    let dir = scratch("resume");
+    let store = CaseStore { dir: OutputDir::create(&dir, false, false).unwrap(), reuse: false };
+    let first = bench::run(&one_null(), Some(&store), &|_, _| {}).unwrap();
+    assert_eq!(first.cases.len(), 1);
+    assert!(first.cases[0].error.is_none(), "{:?}", first.cases[0].error);
+    let files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(files.len(), 1, "one file per finished case: {files:?}");
+
+    // Mark the kept case: a resumed run must report it as kept, not run it again.
+    let text = std::fs::read_to_string(&files[0]).unwrap();
+    let mut kept: serde_json::Value = serde_json::from_str(&text).unwrap();
+    kept["seconds"] = serde_json::json!(-1.0);
+    std::fs::write(&files[0], serde_json::to_string(&kept).unwrap()).unwrap();
+    let resumed = CaseStore { dir: OutputDir::create(&dir, false, true).unwrap(), reuse: true };
+    let second = bench::run(&one_null(), Some(&resumed), &|_, _| {}).unwrap();
+    assert_eq!(second.cases[0].seconds, -1.0);
+    assert_eq!(second.cases[0].diagnosed, first.cases[0].diagnosed);
+
+    // Without reuse the case runs again, with the same draws and the same answer.
+    let fresh = CaseStore { dir: OutputDir::create(&dir, true, false).unwrap(), reuse: false };
+    let third = bench::run(&one_null(), Some(&fresh), &|_, _| {}).unwrap();
+    assert!(third.cases[0].seconds >= 0.0);
+    assert_eq!(third.cases[0].truth, first.cases[0].truth);
+    assert_eq!(third.cases[0].ranking, first.cases[0].ranking);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn families_are_named_and_plant_only_their_own_effects() {
+    assert_eq!("beam".parse::<Family>().unwrap(), Family::Beam);
+    let e = "enf".parse::<Family>().unwrap_err().to_string();
+    assert!(e.contains("unknown family `enf`") && e.contains("dcb, beam"), "{e}");
+    let opts = BenchOptions { effects: vec!["steel_hardening".into()], ..one_null() };
+    let e = bench::run(&opts, None, &|_, _| {}).unwrap_err().to_string();
+    assert!(e.contains("cannot be planted in the dcb benchmark"), "{e}");
+}
