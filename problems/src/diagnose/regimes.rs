@@ -12,8 +12,16 @@
 //!   machine effects grow most).
 //!
 //! A curve that never falls 5 % below its peak has no propagation or late stage.
+//!
+//! Some models have regimes of their own, chosen per experiment from the name of its forward model
+//! ([`Family::of_model`]): an FRP-strengthened beam (`frp_beam`) is split into uncracked, cracked,
+//! yielded and debonding ([`beam`]); every other model gets the generic regimes above.
 
+pub mod beam;
+
+use crate::data::Experiment;
 use crate::diagnose::gauge::{Gauge, Misfit};
+use crate::identification::Setup;
 use serde::Serialize;
 
 /// Secant stiffness drop that ends the initial loading.
@@ -30,12 +38,53 @@ const PROPAGATION_SHARE: f64 = 2.0 / 3.0;
 /// Regime names, in test order.
 pub const NAMES: [&str; 4] = ["initial loading", "onset/peak", "propagation", "late stage"];
 
+/// A set of regimes and the rule that finds them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    /// Any test that loads, peaks and softens: [`NAMES`], found by [`split`].
+    Generic,
+    /// An FRP-strengthened RC beam: [`beam::NAMES`], found by [`beam::split`].
+    Beam,
+}
+
+impl Family {
+    /// The regime set for a forward model type (`ForwardModel::name`).
+    pub fn of_model(model: &str) -> Self {
+        match model {
+            "frp_beam" => Family::Beam,
+            _ => Family::Generic,
+        }
+    }
+
+    /// Regime names, in test order.
+    pub fn names(self) -> [&'static str; 4] {
+        match self {
+            Family::Generic => NAMES,
+            Family::Beam => beam::NAMES,
+        }
+    }
+
+    /// The regime held out of a fit to check transfer, when it is the last of a test: the late
+    /// stage of a generic curve, the debonding of a beam.
+    pub fn held_out(self) -> &'static str {
+        self.names()[3]
+    }
+
+    /// How the held-out part is named in reports.
+    pub fn held_out_label(self) -> &'static str {
+        match self {
+            Family::Generic => "late stage of each curve",
+            Family::Beam => "debonding regime of each curve",
+        }
+    }
+}
+
 /// One regime of one experiment: displacements in `[from, to)` (mm).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Regime {
     /// Experiment name.
     pub experiment: String,
-    /// One of [`NAMES`].
+    /// One of [`NAMES`] (or of its family's names, [`Family::names`]).
     pub name: String,
     /// First displacement (mm).
     pub from: f64,
@@ -86,9 +135,35 @@ pub fn contains(regime: &Regime, x: f64, last: bool) -> bool {
     x >= regime.from && (x < regime.to || (last && x <= regime.to))
 }
 
-/// The regimes of every experiment of a gauge, from its load curves.
+/// The regimes of every experiment of a gauge, from its load curves, by the generic rule.
 pub fn split_all(gauge: &Gauge) -> Vec<Regime> {
     gauge.blocks.iter().filter(|b| b.term == "F").flat_map(|b| split(&b.experiment, &b.x, &b.y)).collect()
+}
+
+/// The regime set of `experiment` in `setup` (generic when it has no model there).
+pub fn family(setup: &Setup, experiment: &str) -> Family {
+    setup.models.get(experiment).map_or(Family::Generic, |m| Family::of_model(m.name()))
+}
+
+/// The regimes of every experiment of a gauge, each by the rule of its model's family in `setup`;
+/// a beam's debonded length is taken from `experiments` when measured (fitted or not).
+pub fn split_setup(gauge: &Gauge, setup: &Setup, experiments: &[Experiment]) -> Vec<Regime> {
+    gauge
+        .blocks
+        .iter()
+        .filter(|b| b.term == "F")
+        .flat_map(|b| match family(setup, &b.experiment) {
+            Family::Generic => split(&b.experiment, &b.x, &b.y),
+            Family::Beam => {
+                let length = experiments
+                    .iter()
+                    .find(|e| e.name == b.experiment)
+                    .and_then(|e| e.debonded_length.as_ref())
+                    .map(|c| (c.x(), c.y()));
+                beam::split(&b.experiment, &b.x, &b.y, length)
+            }
+        })
+        .collect()
 }
 
 /// Misfit of one response in one regime.
