@@ -18,7 +18,8 @@ use std::time::Instant;
 
 /// Significance of the base misfit against the noise (χ² with n − p degrees of freedom).
 const NOISE_LEVEL: f64 = 1e-3;
-/// Realised shrinkage below which the held-out late stage is not refitted for a candidate.
+/// Realised shrinkage below which the held-out part (late stage; a beam's debonding) is not
+/// refitted for a candidate.
 const TRANSFER_FROM: f64 = 0.05;
 /// Cosine above which two candidates are reported as confusable.
 pub const CONFUSABLE: f64 = 0.9;
@@ -39,7 +40,8 @@ pub struct Options {
     pub noise: NoiseLevels,
     /// Other tests predicted with the calibrated parameters (transfer), e.g. other specimens.
     pub withheld: Vec<LoadedProblem>,
-    /// Also check transfer to the held-out late stage of each curve.
+    /// Also check transfer to the held-out last regime of each curve (the late stage; a beam's
+    /// debonding, [`regimes::Family::held_out`]).
     pub holdout: bool,
     /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
     pub always_refit: Vec<String>,
@@ -430,7 +432,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     let p_noise = chi2_survival(chi2, dof as f64);
 
     // 2. Where.
-    let regs = regimes::split_all(&gauge);
+    let regs = regimes::split_setup(&gauge, &base, &subject.experiments);
     let by_regime = regimes::misfit_by_regime(&gauge, &regs, &misfit);
 
     // 3. Identifiability.
@@ -515,17 +517,28 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     // 5. How far: refits and transfer.
     let (base_aic, base_bic) = aic_bic(chi2, n, p);
     let base_regime_chi2 = regimes::rss_by_regime(&gauge, &regs, &misfit.r);
-    let split = |exp: &str| -> f64 {
-        regs.iter().find(|r| r.experiment == exp && r.name == regimes::NAMES[3]).map(|r| r.from).unwrap_or_else(|| {
-            let b = gauge.blocks.iter().find(|b| b.experiment == exp).expect("experiment has a block");
-            b.x[0] + 0.75 * (b.x[b.x.len() - 1] - b.x[0])
-        })
+    // The held-out part of each curve: its family's held-out regime when that is its last regime
+    // (the late stage; a beam's debonding), else the last quarter of its displacements.
+    let mut starts: BTreeMap<String, (f64, Option<regimes::Family>)> = BTreeMap::new();
+    for b in gauge.blocks.iter().filter(|b| b.term == "F") {
+        let family = regimes::family(&base, &b.experiment);
+        let held = family.held_out();
+        let from = regs.iter().rfind(|r| r.experiment == b.experiment).filter(|r| r.name == held).map(|r| r.from);
+        let quarter = b.x[0] + 0.75 * (b.x[b.x.len() - 1] - b.x[0]);
+        starts.insert(b.experiment.clone(), (from.unwrap_or(quarter), from.map(|_| family)));
+    }
+    let split = |exp: &str| starts.get(exp).map_or(f64::INFINITY, |s| s.0);
+    let kinds: Vec<Option<regimes::Family>> = starts.values().map(|s| s.1).collect();
+    let held_label = match kinds.first() {
+        Some(Some(f)) if kinds.iter().all(|g| *g == Some(*f)) => f.held_out_label(),
+        Some(None) if kinds.iter().all(Option::is_none) => "last quarter of each curve",
+        _ => "last regime or quarter of each curve",
     };
     let early = gauge.restricted(|e, x| x < split(e));
     let early_rows = gauge.rows(|e, x| x < split(e));
     let late = gauge.restricted(|e, x| x >= split(e));
     let holdout_base = if opts.holdout && !late.is_empty() && !early.is_empty() {
-        say("base fit without the late stage (held out)");
+        say(&format!("base fit without the {held_label} (held out)"));
         let fe = base_residuals(&early, &base, &space);
         let r = lsq::minimize_from(&fe, &u, &[], &REFIT, Some(select_rows(&lin.jac, &early_rows)))?;
         let predicted = late.evaluate(&space.apply(&base, &space.from_unit(&r.u))?)?;
@@ -654,12 +667,13 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         if best_records.is_none() {
             best_records = Some((c.name().to_string(), out.misfit.records));
         }
-        // Transfer 1: the late stage of every curve, held out of both fits. An effect that barely
-        // changes the fit has nothing to transfer, and its refit may be dear (large rotations).
+        // Transfer 1: the last regime of every curve (late stage, debonding), held out of both
+        // fits. An effect that barely changes the fit has nothing to transfer, and its refit may
+        // be dear (large rotations).
         let realised = 1.0 - chi / chi2.max(f64::MIN_POSITIVE);
         if holdout_base.is_some() && realised < TRANSFER_FROM {
             res.transfer.push(Transfer {
-                withheld: "late stage of each curve".into(),
+                withheld: held_label.into(),
                 readings: late.len(),
                 base_chi2: holdout_base.unwrap_or(f64::NAN),
                 effect_chi2: None,
@@ -670,7 +684,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
                 )),
             });
         } else if let Some(base_late) = holdout_base {
-            say(&format!("{}: fit without the late stage, predict it", c.name()));
+            say(&format!("{}: fit without the {held_label}, predict it", c.name()));
             let jac_early = out.jacobian.as_ref().map(|j| select_rows(j, &early_rows));
             let t = refit_on(&early, &base, &space, *c, &params, &out.v, jac_early).and_then(|o| {
                 let m = extended(&late, &base, &space, *c, &params);
@@ -678,7 +692,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
             });
             res.transfer.push(match t {
                 Ok(e) => Transfer {
-                    withheld: "late stage of each curve".into(),
+                    withheld: held_label.into(),
                     readings: late.len(),
                     base_chi2: base_late,
                     effect_chi2: Some(e),
@@ -686,7 +700,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
                     note: None,
                 },
                 Err(e) => Transfer {
-                    withheld: "late stage of each curve".into(),
+                    withheld: held_label.into(),
                     readings: late.len(),
                     base_chi2: base_late,
                     effect_chi2: None,
