@@ -25,3 +25,5 @@ pub mod paper_dcb {}
 pub mod real_dcb {}
 #[doc = include_str!("src/diagnose.md")]
 pub mod diagnose {}
+#[doc = include_str!("src/diagnose_beam.md")]
+pub mod diagnose_beam {}
