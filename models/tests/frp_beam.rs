@@ -91,7 +91,7 @@ fn null_effects_reproduce_the_base_model_bit_for_bit() {
     let mut with = base.clone();
     with.effects = toml::from_str(
         "adhesive_shear_compliance = 0.0\nadhesive_normal_compliance = 0.0\nshrinkage_strain = 0.0\n\
-         steel_hardening_offset = 0.0\nfracture_energy_offset = 0.0\ntensile_strength_offset = 0.0\n\
+         steel_hardening_offset = 0.0\n\
          deflection_offset = 0.0",
     )
     .unwrap();

@@ -77,7 +77,7 @@ fn the_beam_candidates_apply_to_the_frp_beam_only_and_are_null_there() {
     let applies: Vec<&str> = library.all().into_iter().filter(|c| c.applies(&setup)).map(|c| c.name()).collect();
     // Bridging applies to any setup with a bilinear law; the rest are the beam's own.
     assert!(applies.len() >= 4, "{applies:?}");
-    for name in ["adhesive_compliance", "shrinkage_strain", "steel_hardening", "concrete_softening"] {
+    for name in ["adhesive_compliance", "shrinkage_strain", "steel_hardening", "deflection_offset"] {
         assert!(applies.contains(&name), "{name} missing from {applies:?}");
         let c = library.select(&[name.to_string()]).unwrap()[0];
         let s = c.apply(&setup, &nulls(c, &setup)).unwrap();

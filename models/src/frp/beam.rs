@@ -395,16 +395,7 @@ impl FrpBeam {
     fn materials(&self) -> Result<(crate::materials::Concrete, crate::materials::Steel)> {
         use crate::materials::UniaxialMaterial;
         let e = &self.effects;
-        let mut concrete = self.section.concrete.clone();
-        if e.tensile_strength_offset != 0.0 {
-            concrete.tensile_strength += e.tensile_strength_offset;
-        }
-        if e.fracture_energy_offset != 0.0 {
-            concrete.fracture_energy += e.fracture_energy_offset;
-        }
-        concrete.validate().map_err(|err| {
-            CzError::config(format!("{OWNER}: effects"), format!("the concrete with the effects is invalid: {err}"))
-        })?;
+        let concrete = self.section.concrete.clone();
         let mut steel = self.section.steel.clone();
         if e.steel_hardening_offset != 0.0 {
             steel.hardening_modulus += e.steel_hardening_offset;

@@ -5,6 +5,10 @@
 //! base model **exactly** (bit for bit: the base code path is taken, not a limit of the effect),
 //! and on which the responses depend smoothly away from it, so an identification can switch an
 //! effect on, estimate it and take finite-difference sensitivities to it.
+//!
+//! The concrete's tensile strength and fracture energy are not among them: the model takes its
+//! cracks as formed (they carry no tension) and keeps the concrete between them uncracked, so
+//! neither would change its response.
 
 use czid_core::error::require_non_negative;
 use czid_core::{CzError, Result};
@@ -29,11 +33,6 @@ pub struct BeamEffects {
     /// Added to the bars' hardening modulus E_h (MPa); the result must stay within
     /// `[0, E_s)`. 0: the nominal E_h.
     pub steel_hardening_offset: f64,
-    /// Added to the concrete's fracture energy G_F (N/mm): more or less tension softening
-    /// (tension stiffening) after cracking. 0: the nominal G_F.
-    pub fracture_energy_offset: f64,
-    /// Added to the concrete's tensile strength f_t (MPa): earlier or later cracking. 0: nominal.
-    pub tensile_strength_offset: f64,
     /// Seating offset (mm) added to the recorded deflection, with an unloaded first row at zero
     /// (the toe of a test curve). 0: none.
     pub deflection_offset: f64,
@@ -53,14 +52,13 @@ impl BeamEffects {
                 "must lie within ±0.002",
             ));
         }
-        for (name, v) in [
-            ("effects.steel_hardening_offset", self.steel_hardening_offset),
-            ("effects.fracture_energy_offset", self.fracture_energy_offset),
-            ("effects.tensile_strength_offset", self.tensile_strength_offset),
-        ] {
-            if !v.is_finite() {
-                return Err(CzError::invalid(owner, name, v, "must be finite"));
-            }
+        if !self.steel_hardening_offset.is_finite() {
+            return Err(CzError::invalid(
+                owner,
+                "effects.steel_hardening_offset",
+                self.steel_hardening_offset,
+                "must be finite",
+            ));
         }
         Ok(())
     }

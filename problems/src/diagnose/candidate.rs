@@ -412,7 +412,7 @@ impl Library {
         ));
         // The FRP-strengthened beam: one table entry per switchable effect of the model.
         let frp = ["frp_beam"];
-        let entries: [Entry; 7] = [
+        let entries: [Entry; 5] = [
             (
                 "adhesive_compliance",
                 "shear compliance of the adhesive layer in series with the bond law",
@@ -443,22 +443,6 @@ impl Library {
                 "effects.steel_hardening_offset",
                 "MPa",
                 [-1500.0, 3000.0],
-                false,
-            ),
-            (
-                "concrete_softening",
-                "more or less tension softening of the cracked concrete (fracture energy)",
-                "effects.fracture_energy_offset",
-                "N/mm",
-                [-0.05, 0.1],
-                false,
-            ),
-            (
-                "concrete_cracking",
-                "earlier or later cracking (concrete tensile strength)",
-                "effects.tensile_strength_offset",
-                "MPa",
-                [-1.0, 1.0],
                 false,
             ),
             (

@@ -168,10 +168,6 @@ impl Family {
             (Family::Beam, "shrinkage_strain") => vec![-rng.random_range(1e-4..3e-4)],
             // Bars hardening at 0.25–0.75 % or 1.25–2.25 % of E_s instead of the assumed 1 %.
             (Family::Beam, "steel_hardening") => vec![sign(rng) * rng.random_range(500.0..1500.0)],
-            // Concrete fracture energy 15–35 % off the model code's 0.146 N/mm.
-            (Family::Beam, "concrete_softening") => vec![sign(rng) * rng.random_range(0.02..0.05)],
-            // Tensile strength 0.3–0.8 MPa off the 3.7 MPa estimated from f'c.
-            (Family::Beam, "concrete_cracking") => vec![sign(rng) * rng.random_range(0.3..0.8)],
             // Seating of the supports and load points: 0.3–1.5 mm.
             (Family::Beam, "deflection_offset") => vec![rng.random_range(0.3..1.5)],
             _ => return None,
