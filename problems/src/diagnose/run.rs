@@ -334,6 +334,9 @@ fn refit_on(
 /// run per step (a large-rotation run costs ~50 small-rotation ones), one fresh finite-difference
 /// Jacobian if they stall.
 const REFIT: LsOptions = LsOptions { max_iterations: 40, step: 2e-3, tolerance: 1e-6, fd_jacobians: 3 };
+/// Unit-cube values from which the secondary parameters of a several-parameter effect are refitted
+/// again.
+const SECONDARY_STARTS: [f64; 3] = [0.1, 0.3, 0.6];
 /// A switched-on effect only moves the fitted parameters, whose Jacobian barely changes with it;
 /// its runs can be far dearer (large rotations), so fewer iterations and one fresh Jacobian.
 const REFIT_SWITCH: LsOptions = LsOptions { max_iterations: 8, step: 2e-3, tolerance: 1e-4, fd_jacobians: 1 };
@@ -619,13 +622,34 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
             m.columns_mut(p, params.len()).copy_from(&sens.columns);
             m
         };
-        let out = match refit_on(&gauge, &base, &space, *c, &params, &start, Some(jac0)) {
+        let mut out = match refit_on(&gauge, &base, &space, *c, &params, &start, Some(jac0)) {
             Ok(o) => o,
             Err(e) => {
                 res.error = Some(format!("refit failed: {e}"));
                 continue;
             }
         };
+        // An effect of several parameters can trade one against another along a valley (a
+        // bridging tail's strength against its length): the refit is repeated from other values
+        // of every parameter but the first, and the best kept.
+        if !c.discrete() && params.len() > 1 {
+            for j in 1..params.len() {
+                for w in SECONDARY_STARTS {
+                    if (out.v[p + j] - w).abs() < 0.1 {
+                        continue;
+                    }
+                    let mut v = out.v.clone();
+                    v[p + j] = w;
+                    if let Ok(o) = refit_on(&gauge, &base, &space, *c, &params, &v, out.jacobian.clone()) {
+                        if o.misfit.rss() < out.misfit.rss() {
+                            out = RefitOutcome { evaluations: out.evaluations + o.evaluations, ..o };
+                        } else {
+                            out.evaluations += o.evaluations;
+                        }
+                    }
+                }
+            }
+        }
         let k = p + if c.discrete() { 1 } else { sens.columns.ncols() };
         let chi = out.misfit.rss();
         let (aic, bic) = aic_bic(chi, n, k);

@@ -22,6 +22,10 @@ use std::ops::Range;
 const DCB_READINGS: Range<usize> = 320..460;
 /// DCB final opening (mm): the bundled real DCB tests end at 26.7 to 36.9 mm.
 const DCB_OPENING: Range<f64> = 26.0..38.0;
+/// Longest crack of a DCB test (mm): tests stop before the crack nears the end of the 123 mm
+/// specimen (the bundled ones stopped at 79 to 108 mm), and the candidates' runs (a longer crack,
+/// a softer arm) must still end inside it.
+const DCB_LAST_CRACK: f64 = 100.0;
 /// DCB load noise (N): the bundled real tests scatter by about 0.2 N from reading to reading.
 const DCB_LOAD_NOISE: Range<f64> = 0.1..0.6;
 /// DCB crack-length noise (mm): their crack lengths scatter by about 0.1 mm, but a crack read by
@@ -69,6 +73,15 @@ pub struct TestDraw {
     pub end: Option<f64>,
 }
 
+/// Opening (mm) at which a DCB like Hartlen's with toughness `truth[1]` (N/mm) and arm modulus
+/// `truth[2]` (MPa) has a crack of length `a` (mm), by beam theory: `P = √(G b E I)/a` and
+/// `δ = 2 P a³/(3 E I)` (shear and root rotation make the real crack shorter at that opening).
+fn dcb_opening_at(a: f64, truth: &[f64; 3]) -> f64 {
+    let d = Dcb::hartlen_dcb01();
+    let ei = truth[2] * d.width * d.h.powi(3) / 12.0;
+    2.0 * a * a * (truth[1] * d.width * ei).sqrt() / (3.0 * ei)
+}
+
 impl Family {
     /// Name of the family, of its experiment and of its model in the setup.
     pub fn name(&self) -> &'static str {
@@ -107,7 +120,7 @@ impl Family {
                     [rng.random_range(20.0..45.0), rng.random_range(0.5..1.2), rng.random_range(16_000.0..30_000.0)];
                 let noise = [rng.random_range(DCB_LOAD_NOISE), rng.random_range(DCB_LENGTH_NOISE)];
                 let readings = rng.random_range(DCB_READINGS);
-                let end = Some(rng.random_range(DCB_OPENING));
+                let end = Some(rng.random_range(DCB_OPENING).min(dcb_opening_at(DCB_LAST_CRACK, &truth)));
                 TestDraw { truth, noise, readings, end }
             }
             Family::Beam => {
