@@ -167,13 +167,13 @@ fn case(index: usize, planted: &str, seed: u64, family: Family, library: &Librar
                 Err(f) => return Err(CzError::Simulation(format!("planted model: {f}"))),
             }
         };
-        // Without a set end the test ends at its peak load (a beam: IC debonding).
+        // Without a set end the test is read up to a share of the deflection at its peak load.
         let end = match end {
             Some(e) => e,
             None => {
                 let load = record.curve(columns::DISPLACEMENT, columns::LOAD)?;
                 let peak = (0..load.len()).max_by(|&a, &b| load.y()[a].total_cmp(&load.y()[b])).unwrap_or(0);
-                load.x()[peak]
+                family.share_of_peak() * load.x()[peak]
             }
         };
         out.opening = end;
@@ -190,13 +190,14 @@ fn case(index: usize, planted: &str, seed: u64, family: Family, library: &Librar
             initial_crack: None,
         };
         let space = family.space();
-        let u0: Vec<f64> = space.to_unit(&truth).iter().zip(&jitter).map(|(u, j)| (u + j).clamp(0.0, 1.0)).collect();
+        let u0: Vec<f64> =
+            space.to_unit(&truth[..space.dim()]).iter().zip(&jitter).map(|(u, j)| (u + j).clamp(0.0, 1.0)).collect();
         let subject = Subject {
             name: format!("case {index}"),
             setup: base,
             space,
             experiments: vec![experiment],
-            use_length: true,
+            use_length: family.fits_length(),
         };
         let opts = Options {
             refit: 1,
