@@ -6,7 +6,7 @@ use czid_core::{columns, CohesiveLaw, Curve, ForwardModel, Parameter, ParameterS
 use czid_models::frp::beam::FrpBeam;
 use czid_problems::data::Experiment;
 use czid_problems::diagnose::gauge::{Gauge, NoiseLevels};
-use czid_problems::diagnose::regimes::{self, beam, Family, Regime};
+use czid_problems::diagnose::regimes::{self, beam, Regime, RegimeSet};
 use czid_problems::diagnose::run::{diagnose_subject, Diagnosis, Subject};
 use czid_problems::diagnose::{Library, Options};
 use czid_problems::identification::Setup;
@@ -206,10 +206,10 @@ fn section_record(x: &[f64], y: &[f64]) -> Record {
 
 #[test]
 fn the_regime_set_is_chosen_per_experiment_from_its_model() {
-    assert_eq!(Family::of_model("frp_beam"), Family::Beam);
-    assert_eq!(Family::of_model("dcb"), Family::Generic);
-    assert_eq!(Family::Beam.held_out(), "debonding");
-    assert_eq!(Family::Generic.held_out(), regimes::NAMES[3]);
+    assert_eq!(RegimeSet::of_model("frp_beam"), RegimeSet::Beam);
+    assert_eq!(RegimeSet::of_model("dcb"), RegimeSet::Generic);
+    assert_eq!(RegimeSet::Beam.held_out(), "debonding");
+    assert_eq!(RegimeSet::Generic.held_out(), regimes::NAMES[3]);
     let beam = FrpBeam::paper().unwrap();
     let rec = record(&beam);
     let s = synthesize(&rec, 200, None, &Noise { load_sd: 0.0, length_sd: 0.0, seed: 1 }).unwrap();

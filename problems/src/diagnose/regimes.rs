@@ -14,7 +14,7 @@
 //! A curve that never falls 5 % below its peak has no propagation or late stage.
 //!
 //! Some models have regimes of their own, chosen per experiment from the name of its forward model
-//! ([`Family::of_model`]): an FRP-strengthened beam (`frp_beam`) is split into uncracked, cracked,
+//! ([`RegimeSet::of_model`]): an FRP-strengthened beam (`frp_beam`) is split into uncracked, cracked,
 //! yielded and debonding ([`beam`]); every other model gets the generic regimes above.
 
 pub mod beam;
@@ -40,27 +40,27 @@ pub const NAMES: [&str; 4] = ["initial loading", "onset/peak", "propagation", "l
 
 /// A set of regimes and the rule that finds them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Family {
+pub enum RegimeSet {
     /// Any test that loads, peaks and softens: [`NAMES`], found by [`split`].
     Generic,
     /// An FRP-strengthened RC beam: [`beam::NAMES`], found by [`beam::split`].
     Beam,
 }
 
-impl Family {
+impl RegimeSet {
     /// The regime set for a forward model type (`ForwardModel::name`).
     pub fn of_model(model: &str) -> Self {
         match model {
-            "frp_beam" => Family::Beam,
-            _ => Family::Generic,
+            "frp_beam" => RegimeSet::Beam,
+            _ => RegimeSet::Generic,
         }
     }
 
     /// Regime names, in test order.
     pub fn names(self) -> [&'static str; 4] {
         match self {
-            Family::Generic => NAMES,
-            Family::Beam => beam::NAMES,
+            RegimeSet::Generic => NAMES,
+            RegimeSet::Beam => beam::NAMES,
         }
     }
 
@@ -73,8 +73,8 @@ impl Family {
     /// How the held-out part is named in reports.
     pub fn held_out_label(self) -> &'static str {
         match self {
-            Family::Generic => "late stage of each curve",
-            Family::Beam => "debonding regime of each curve",
+            RegimeSet::Generic => "late stage of each curve",
+            RegimeSet::Beam => "debonding regime of each curve",
         }
     }
 }
@@ -84,7 +84,7 @@ impl Family {
 pub struct Regime {
     /// Experiment name.
     pub experiment: String,
-    /// One of [`NAMES`] (or of its family's names, [`Family::names`]).
+    /// One of [`NAMES`] (or of its family's names, [`RegimeSet::names`]).
     pub name: String,
     /// First displacement (mm).
     pub from: f64,
@@ -141,8 +141,8 @@ pub fn split_all(gauge: &Gauge) -> Vec<Regime> {
 }
 
 /// The regime set of `experiment` in `setup` (generic when it has no model there).
-pub fn family(setup: &Setup, experiment: &str) -> Family {
-    setup.models.get(experiment).map_or(Family::Generic, |m| Family::of_model(m.name()))
+pub fn regime_set(setup: &Setup, experiment: &str) -> RegimeSet {
+    setup.models.get(experiment).map_or(RegimeSet::Generic, |m| RegimeSet::of_model(m.name()))
 }
 
 /// The regimes of every experiment of a gauge, each by the rule of its model's family in `setup`;
@@ -152,9 +152,9 @@ pub fn split_setup(gauge: &Gauge, setup: &Setup, experiments: &[Experiment]) -> 
         .blocks
         .iter()
         .filter(|b| b.term == "F")
-        .flat_map(|b| match family(setup, &b.experiment) {
-            Family::Generic => split(&b.experiment, &b.x, &b.y),
-            Family::Beam => {
+        .flat_map(|b| match regime_set(setup, &b.experiment) {
+            RegimeSet::Generic => split(&b.experiment, &b.x, &b.y),
+            RegimeSet::Beam => {
                 let length = experiments
                     .iter()
                     .find(|e| e.name == b.experiment)

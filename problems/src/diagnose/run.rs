@@ -41,7 +41,7 @@ pub struct Options {
     /// Other tests predicted with the calibrated parameters (transfer), e.g. other specimens.
     pub withheld: Vec<LoadedProblem>,
     /// Also check transfer to the held-out last regime of each curve (the late stage; a beam's
-    /// debonding, [`regimes::Family::held_out`]).
+    /// debonding, [`regimes::RegimeSet::held_out`]).
     pub holdout: bool,
     /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
     pub always_refit: Vec<String>,
@@ -522,16 +522,16 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     let base_regime_chi2 = regimes::rss_by_regime(&gauge, &regs, &misfit.r);
     // The held-out part of each curve: its family's held-out regime when that is its last regime
     // (the late stage; a beam's debonding), else the last quarter of its displacements.
-    let mut starts: BTreeMap<String, (f64, Option<regimes::Family>)> = BTreeMap::new();
+    let mut starts: BTreeMap<String, (f64, Option<regimes::RegimeSet>)> = BTreeMap::new();
     for b in gauge.blocks.iter().filter(|b| b.term == "F") {
-        let family = regimes::family(&base, &b.experiment);
+        let family = regimes::regime_set(&base, &b.experiment);
         let held = family.held_out();
         let from = regs.iter().rfind(|r| r.experiment == b.experiment).filter(|r| r.name == held).map(|r| r.from);
         let quarter = b.x[0] + 0.75 * (b.x[b.x.len() - 1] - b.x[0]);
         starts.insert(b.experiment.clone(), (from.unwrap_or(quarter), from.map(|_| family)));
     }
     let split = |exp: &str| starts.get(exp).map_or(f64::INFINITY, |s| s.0);
-    let kinds: Vec<Option<regimes::Family>> = starts.values().map(|s| s.1).collect();
+    let kinds: Vec<Option<regimes::RegimeSet>> = starts.values().map(|s| s.1).collect();
     let held_label = match kinds.first() {
         Some(Some(f)) if kinds.iter().all(|g| *g == Some(*f)) => f.held_out_label(),
         Some(None) if kinds.iter().all(Option::is_none) => "last quarter of each curve",
