@@ -59,8 +59,8 @@ pub struct CaseResult {
     pub noise: [f64; 2],
     /// Readings of the synthetic test.
     pub readings: usize,
-    /// Its final displacement (mm).
-    pub opening: f64,
+    /// Its final displacement (mm): a DCB's opening, a beam's mid-span deflection.
+    pub end: f64,
     /// Diagnosed effect ([`NONE`] when no candidate is significant).
     pub diagnosed: String,
     /// Candidates by score, best first, with whether they are significant.
@@ -130,7 +130,7 @@ fn case(index: usize, planted: &str, seed: u64, family: Family, library: &Librar
         truth,
         noise,
         readings,
-        opening: end.unwrap_or(f64::NAN),
+        end: end.unwrap_or(f64::NAN),
         diagnosed: NONE.into(),
         ranking: Vec::new(),
         base_reduced_chi2: f64::NAN,
@@ -176,7 +176,7 @@ fn case(index: usize, planted: &str, seed: u64, family: Family, library: &Librar
                 family.share_of_peak() * load.x()[peak]
             }
         };
-        out.opening = end;
+        out.end = end;
         let data = synthesize(
             &record,
             readings,
