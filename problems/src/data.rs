@@ -146,27 +146,26 @@ impl ExperimentSpec {
         for (i, record) in reader.records().enumerate() {
             let row = i + 2;
             let record = record.map_err(|e| CzError::data(format!("{shown}, row {row}"), e.to_string()))?;
-            let cell = |col: usize| -> Result<f64> {
+            // A value is read, converted to N or mm, and checked after the conversion: a huge
+            // reading in metres or kilonewtons can overflow to infinity on the way.
+            let cell = |col: usize, factor: f64| -> Result<f64> {
                 let raw = record.get(col).unwrap_or("");
-                let v: f64 = raw.parse().map_err(|_| {
-                    CzError::data(
-                        format!("{shown}, row {row}, column `{}`", header[col]),
-                        format!("`{raw}` is not a number"),
-                    )
-                })?;
+                let at = || format!("{shown}, row {row}, column `{}`", header[col]);
+                let v: f64 = raw.parse().map_err(|_| CzError::data(at(), format!("`{raw}` is not a number")))?;
                 if !v.is_finite() {
-                    return Err(CzError::data(
-                        format!("{shown}, row {row}, column `{}`", header[col]),
-                        format!("`{raw}` is not a finite number"),
-                    ));
+                    return Err(CzError::data(at(), format!("`{raw}` is not a finite number")));
                 }
-                Ok(v)
+                let converted = v * factor;
+                if !converted.is_finite() {
+                    return Err(CzError::data(at(), format!("`{raw}` overflows when converted to N or mm")));
+                }
+                Ok(converted)
             };
             rows.push(Row {
                 line: row,
-                x: cell(ix)? * lu,
-                y: cell(iy)? * fu,
-                crack: ic.map(cell).transpose()?.map(|c| c * lu),
+                x: cell(ix, lu)?,
+                y: cell(iy, fu)?,
+                crack: ic.map(|c| cell(c, lu)).transpose()?,
             });
         }
         if rows.is_empty() {
@@ -209,12 +208,18 @@ impl ExperimentSpec {
             }
         }
         let x: Vec<f64> = monotone.iter().map(|r| r.x).collect();
-        let load = Curve::new(x.clone(), monotone.iter().map(|r| r.y).collect())?;
+        // A curve the checks above let through can still be refused (a crack length minus its
+        // first value can overflow): the error then names the file.
+        let in_file = |e: CzError| CzError::data(&shown, e.to_string());
+        let load = Curve::new(x.clone(), monotone.iter().map(|r| r.y).collect()).map_err(in_file)?;
         let debonded_length = match ic {
             None => None,
             Some(_) => {
                 let offset = initial_crack.unwrap_or(0.0);
-                Some(Curve::new(x, monotone.iter().map(|r| r.crack.unwrap_or(0.0) - offset).collect())?)
+                Some(
+                    Curve::new(x, monotone.iter().map(|r| r.crack.unwrap_or(0.0) - offset).collect())
+                        .map_err(in_file)?,
+                )
             }
         };
         let name = self.file.file_stem().map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
