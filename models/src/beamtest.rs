@@ -5,7 +5,7 @@ use czid_core::error::{require_non_negative, require_positive};
 use czid_core::{columns, CzError, Record, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::fe::path::StepRow;
+use crate::fe::run_types::StepRow;
 
 /// Which 2D idealisation the adherends follow.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -10,6 +10,7 @@
 //! * [`banded`]: band LU factorisation (the linear solver);
 //! * [`newton`]: Newton–Raphson under displacement or dissipation control;
 //! * [`path`]: path following (adaptive steps, output grid, snap-back detours);
+//! * [`run_types`]: what a run is asked and returns (settings, rows, statistics), shared by `path` and `window`;
 //! * `window`: the solution restricted to the nodes around a crack front, the linear regions
 //!   behind and ahead condensed exactly (used by [`path::run_with`]);
 //! * [`energy`]: external work, elastic and dissipated energy;
@@ -37,6 +38,7 @@ pub mod mesh;
 pub mod newton;
 pub mod nonlinear;
 pub mod path;
+pub mod run_types;
 pub mod segment;
 pub(crate) mod window;
 
@@ -44,4 +46,5 @@ pub use assembly::{FeProblem, InterfaceRule, Spring};
 pub use interface::{InterfacePoint, PointKind};
 pub use mesh::{Layer, Mesh, Section};
 pub use newton::NewtonSettings;
-pub use path::{run, run_with, PathSettings, RunOptions, RunStats, StepRow};
+pub use path::{run, run_with};
+pub use run_types::{PathFailure, PathSettings, RunOptions, RunStats, StepRow};

@@ -32,90 +32,8 @@ use super::assembly::{FeProblem, InterfaceRule};
 use super::crack::{self, CrackMeasures};
 use super::energy::{self, Ledger};
 use super::interface::PointKind;
-use super::newton::{Newton, NewtonSettings, StepFailure};
-
-/// How far and how finely to follow the path.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PathSettings {
-    /// Final value of the control unknown (either sign).
-    pub target: f64,
-    /// Number of equally spaced output abscissae between 0 and `target` (all are hit exactly).
-    pub outputs: usize,
-    /// Smallest displacement step, as a fraction of the output spacing, before switching to
-    /// dissipation control.
-    pub min_step_fraction: f64,
-    /// Damage at or above which a point counts as fully debonded.
-    pub damage_threshold: f64,
-    /// Position of the initial crack front (reported as the tip until something debonds).
-    pub crack_origin: f64,
-    /// Newton settings.
-    pub newton: NewtonSettings,
-}
-
-/// One converged state, in the units of the simulated part (not yet scaled by symmetry).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct StepRow {
-    /// Control unknown.
-    pub control: f64,
-    /// Its reaction (work-conjugate generalised force).
-    pub reaction: f64,
-    /// Work of the reaction so far.
-    pub external_work: f64,
-    /// Strain energy of beams, springs and the interface's recoverable part.
-    pub elastic_energy: f64,
-    /// Energy dissipated by the interface so far.
-    pub dissipated_energy: f64,
-    /// Debonded length, process zone and tip along the cohesive points.
-    pub crack: CrackMeasures,
-}
-
-/// Statistics of a run, for profiling and tests.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RunStats {
-    /// Converged steps.
-    pub steps: usize,
-    /// Assemblies (Newton iterations including the final residual check).
-    pub assemblies: usize,
-    /// LU factorisations.
-    pub factorizations: usize,
-    /// Steps that had to be cut.
-    pub cuts: usize,
-    /// Dissipation-controlled steps.
-    pub dissipation_steps: usize,
-    /// Whether the run was solved on a window around the crack front ([`RunOptions::window`]).
-    pub windowed: bool,
-    /// Why a run asked to use the window was solved on the whole mesh instead.
-    pub window_fallback: Option<&'static str>,
-}
-
-/// A failed run: the error and the converged rows.
-#[derive(Clone, Debug)]
-pub struct PathFailure {
-    /// What went wrong.
-    pub error: CzError,
-    /// Rows that converged before it.
-    pub rows: Vec<StepRow>,
-}
-
-/// Choices of a run beyond the path itself.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RunOptions {
-    /// How the interface is integrated. With [`InterfaceRule::Segments`] the crack measures come
-    /// from the segments' fronts and each point's work is integrated along its gap path by the law
-    /// ([`Ledger::commit_along`]).
-    pub interface: InterfaceRule,
-    /// Record only the output abscissae (and the states followed under the dissipation constraint,
-    /// where the output grid cannot be followed) instead of every converged step. Then the rows'
-    /// abscissae do not depend on the parameters, so a response interpolated between them is as
-    /// smooth in the parameters as the states themselves.
-    pub outputs_only: bool,
-    /// Solve only a window around the crack front, the linear regions behind and ahead of it
-    /// condensed exactly (`fe::window`), when the problem fits (small rotations, segments,
-    /// one interface from near the loaded end to the far end, a law linear near the origin); any
-    /// other problem, or a run whose checks fail, is solved on the whole mesh. Records the output
-    /// abscissae only.
-    pub window: bool,
-}
+use super::newton::{Newton, StepFailure};
+use super::run_types::{FrontTrack, PathFailure, PathSettings, RunOptions, RunStats, StepRow};
 
 struct State {
     q: Vec<f64>,
@@ -129,7 +47,9 @@ pub fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Ve
     run_with(p, law, s, &RunOptions::default())
 }
 
-/// [`run`] with the choices of `o`.
+/// [`run`] with the choices of `o`: on the window around the crack front when asked and the
+/// problem fits, else on the whole mesh (displacement control, with dissipation-controlled
+/// detours through snap-backs).
 pub fn run_with(
     p: &FeProblem,
     law: &dyn CohesiveLaw,
@@ -146,357 +66,444 @@ pub fn run_with(
             Err(why) => fallback = Some(why.reason()),
         }
     }
-    let mut nw = Newton::with_rule(p, law, s.newton, o.interface);
-    // With segments, forces are continuous and a good predictor leaves Newton in its basin: the
-    // branch-cycling safeguard of the nodal rule only slows it down.
-    nw.safeguard = o.interface == InterfaceRule::Nodal;
-    let segments = o.interface == InterfaceRule::Segments;
-    // Steps double after convergence in at most this many iterations. With segments a crack front
-    // crossing many points per step is normal work for Newton (typically 4-5 quadratically
-    // converging iterations), not a sign that the step is too long.
-    let (grow_below, shrink_above) = if segments { (5, 9) } else { (3, 7) };
-    let mode_one = if segments { super::segment::ModeOne::of(law) } else { None };
-    let mut before = Vec::new();
-    let n = nw.asm.n();
-    let np = p.points.len();
-    let cohesive: Vec<usize> = (0..np).filter(|&i| p.points[i].kind == PointKind::Cohesive).collect();
-    let xs: Vec<f64> = cohesive.iter().map(|&i| p.mesh.x[p.points[i].node]).collect();
-    let mut dmg = vec![0.0; cohesive.len()];
-    let mut all_damage = vec![0.0; np];
-    let mut point_stored = vec![0.0; np];
-    let mut scratch = vec![0.0; cohesive.len()];
-    let init = law.initial_state();
-    let mut cur = State { q: vec![0.0; n], states: vec![init; np], reaction: 0.0 };
-    let mut prev_q = vec![0.0; n];
-
-    let mut trial = vec![0.0; n];
-    let mut ledger = Ledger::new(np);
-    let mut stats = RunStats { window_fallback: fallback, ..Default::default() };
-    let mut rows =
-        vec![StepRow { crack: CrackMeasures { tip: s.crack_origin, ..Default::default() }, ..Default::default() }];
-
-    let fail = |rows: Vec<StepRow>, msg: String| PathFailure { error: CzError::Simulation(msg), rows };
+    let mut run = WholeMesh::new(p, law, s, o, fallback);
     if !(s.target.is_finite() && s.target != 0.0 && s.outputs > 0) {
-        return Err(fail(rows, "the path needs a finite, non-zero target and at least one output".into()));
+        return Err(run.fail("the path needs a finite, non-zero target and at least one output".into()));
     }
-    let dir = s.target.signum();
-    let spacing = s.target.abs() / s.outputs as f64;
-    let h_min = spacing * s.min_step_fraction;
-    let ic = p.control;
-    // Signed progress along the control unknown.
-    let mut pos = 0.0f64;
-    let mut h = spacing;
-    let mut h_prev = 0.0f64;
-    let mut k_out = 1usize;
-    let mut tau_hint = 0.0f64;
-    let mut front = FrontTrack::default();
-
-    let mut last_diss = 0.0f64;
-    macro_rules! commit {
-        ($lambda:expr, $record:expr) => {{
-            let c_old = cur.q[ic];
-            let r_old = cur.reaction;
-            prev_q.copy_from_slice(&cur.q);
-            cur.q.copy_from_slice(&trial);
-            let reaction = $lambda;
-            if segments {
-                before.clone_from(&cur.states);
-            }
-            for (st, ev) in cur.states.iter_mut().zip(&nw.asm.trial) {
-                *st = ev.state;
-            }
-            cur.reaction = reaction;
-            if segments {
-                let dc = cur.q[ic] - c_old;
-                let (t, g) = (&nw.asm.trial, &nw.asm.gaps);
-                ledger.commit_along(&p.points, law, &before, t, g, dc, r_old, reaction, mode_one.as_ref());
-            } else {
-                ledger.commit(&p.points, &nw.asm.trial, &nw.asm.gaps, cur.q[ic] - c_old, r_old, reaction);
-            }
-            let stored = energy::interface_stored(&p.points, law, &cur.states, &nw.asm.trial, &nw.asm.gaps);
-            let dissipated = ledger.interface_work - stored;
-            // With segments the recoverable energy is integrated like the forces (the dissipation
-            // stays point by point, where the work is integrated).
-            let stored = if segments {
-                for (i, v) in point_stored.iter_mut().enumerate() {
-                    let g = &nw.asm.gaps[i];
-                    *v = match p.points[i].kind {
-                        PointKind::Cohesive => law.stored_energy(g, &cur.states[i]),
-                        PointKind::Contact => 0.5 * nw.asm.trial[i].traction.dot(g),
-                    };
-                }
-                nw.asm.interface_stored(p, &point_stored)
-            } else {
-                stored
-            };
-            if dissipated - last_diss > 0.0 {
-                tau_hint = dissipated - last_diss;
-            }
-            last_diss = dissipated;
-            stats.steps += 1;
-            if segments {
-                front.commit(cur.q[ic], &nw.asm.segments, &nw.asm.fronts);
-            }
-            if $record {
-                let structural = nw.asm.structural_energy(p, &cur.q);
-                let crack = if segments {
-                    for (d, st) in all_damage.iter_mut().zip(&cur.states) {
-                        *d = st.damage;
-                    }
-                    {
-                        let (segs, gaps, st) = (&nw.asm.segments, &nw.asm.gaps, &cur.states);
-                        let level = |k: usize| {
-                            let sg = &segs[k];
-                            super::segment::level_front(
-                                law,
-                                gaps[sg.a],
-                                gaps[sg.b],
-                                &st[sg.a],
-                                &st[sg.b],
-                                s.damage_threshold,
-                            )
-                        };
-                        crack::from_segments(
-                            segs,
-                            &nw.asm.fronts,
-                            |i| all_damage[i],
-                            s.crack_origin,
-                            s.damage_threshold,
-                            level,
-                        )
-                    }
-                } else {
-                    for (d, &i) in dmg.iter_mut().zip(&cohesive) {
-                        *d = cur.states[i].damage;
-                    }
-                    crack::measure(&xs, &dmg, s.damage_threshold, s.crack_origin, &mut scratch)
-                };
-                rows.push(StepRow {
-                    control: cur.q[ic],
-                    reaction,
-                    external_work: ledger.external_work,
-                    elastic_energy: structural + stored,
-                    dissipated_energy: dissipated,
-                    crack,
-                });
-            }
-        }};
-    }
-
-    let target = s.target.abs();
-    let eps = 1e-12 * spacing;
-    let mut dissipating = false;
-    // After a detour through dissipation control, one failed displacement step sends the path
-    // straight back (no step halving): the snap-backs of a propagating crack come one per node.
-    let mut quick_fallback = false;
-    let mut tau = 0.0f64;
-    let mut last: Option<(f64, f64)> = None;
-    // Control increment of the last dissipation step that moved forward (0: none).
-    let mut dc_last = 0.0f64;
-    let mut overshoots = 0usize;
-    let max_steps = 200 * s.outputs + 20_000;
-    while pos < target - eps {
-        if stats.steps > max_steps {
-            return Err(fail(rows, format!("gave up after {} steps at control {:.6}", stats.steps, dir * pos)));
+    let mut path = Control::new(s);
+    while path.pos < path.target - path.eps {
+        if run.stats.steps > path.max_steps {
+            let msg = format!("gave up after {} steps at control {:.6}", run.stats.steps, path.dir * path.pos);
+            return Err(run.fail(msg));
         }
-        if !dissipating {
-            while k_out < s.outputs && spacing * k_out as f64 <= pos + eps {
-                k_out += 1;
-            }
-            let next = if k_out >= s.outputs { target } else { spacing * k_out as f64 };
-            let dh = h.min(next - pos);
-            // Predictor: extrapolate the last increment.
-            let alpha = if h_prev > 0.0 { dh / h_prev } else { 0.0 };
-            for i in 0..n {
-                trial[i] = cur.q[i] + alpha * (cur.q[i] - prev_q[i]);
-            }
-            if let Some(da) = front.advance(dir * dh) {
-                shift_predictor(p, &cur.q, &mut trial, front.x, da, front.zone());
-            }
-            trial[ic] = dir * (pos + dh);
-            match nw.solve_displacement(p, law, &cur.states, &mut trial) {
-                Ok(it) => {
-                    let reaction = nw.f[ic];
-                    let lands = (next - (pos + dh)).abs() <= eps;
-                    commit!(reaction, !o.outputs_only || lands);
-                    pos = if (next - (pos + dh)).abs() <= eps { next } else { pos + dh };
-                    h_prev = dh;
-                    quick_fallback = false;
-                    if it <= grow_below {
-                        h = (2.0 * h).min(spacing);
-                    } else if it >= shrink_above {
-                        h *= 0.5;
-                    }
-                }
-                Err(e) => {
-                    stats.cuts += 1;
-                    h = 0.5 * dh;
-                    if h >= h_min && !quick_fallback {
-                        continue;
-                    }
-                    // Snap-back (or a genuinely hard step): follow the path by dissipation. That
-                    // needs a loaded, dissipating state; without one no snap-back is possible and
-                    // the failure is genuine.
-                    if !(tau_hint > 0.0 && cur.reaction != 0.0 && cur.q[ic] != 0.0) {
-                        let msg = format!(
-                            "no convergence at control {:.6} ({e:?}) even with steps of {:.3e}, and nothing has \
-                             dissipated yet, so no snap-back to follow",
-                            dir * (pos + dh),
-                            dh
-                        );
-                        return Err(fail(rows, msg));
-                    }
-                    dissipating = true;
-                    if tau <= 0.0 || !quick_fallback {
-                        tau = tau_hint;
-                    }
-                    last = None;
-                }
-            }
+        if path.dissipating {
+            run.dissipation_step(&mut path)?;
         } else {
-            let c0 = cur.q[ic];
-            let l0 = cur.reaction;
-            // Do not jump past the target: the run must end exactly on it.
-            let tau_try = if dc_last > 0.0 && pos + dc_last * 1.5 > target {
-                tau * (0.5 * (target - pos) / dc_last).clamp(0.05, 1.0)
-            } else {
-                tau
+            run.displacement_step(&mut path)?;
+        }
+    }
+    Ok(run.finish())
+}
+
+/// Where the path stands along the control unknown, and how the next step is chosen.
+struct Control {
+    /// Sign of the target.
+    dir: f64,
+    /// Output spacing (absolute control).
+    spacing: f64,
+    /// Smallest displacement step before switching to dissipation control.
+    h_min: f64,
+    /// `|target|`.
+    target: f64,
+    /// Tolerance on landing on an output abscissa.
+    eps: f64,
+    /// Step cap of the run.
+    max_steps: usize,
+    /// Signed progress along the control unknown.
+    pos: f64,
+    /// Next displacement step and the last one taken.
+    h: f64,
+    h_prev: f64,
+    /// Index of the next output abscissa.
+    k_out: usize,
+    /// Following the path by dissipation (a snap-back) rather than by displacement.
+    dissipating: bool,
+    /// After a detour through dissipation control, one failed displacement step sends the path
+    /// straight back (no step halving): the snap-backs of a propagating crack come one per node.
+    quick_fallback: bool,
+    /// Released energy per dissipation step.
+    tau: f64,
+    /// Load increment and released energy of the last dissipation step (its predictor).
+    last: Option<(f64, f64)>,
+    /// Control increment of the last dissipation step that moved forward (0: none).
+    dc_last: f64,
+    /// Dissipation steps retried because they would end beyond the target.
+    overshoots: usize,
+}
+
+impl Control {
+    fn new(s: &PathSettings) -> Self {
+        let spacing = s.target.abs() / s.outputs as f64;
+        Control {
+            dir: s.target.signum(),
+            spacing,
+            h_min: spacing * s.min_step_fraction,
+            target: s.target.abs(),
+            eps: 1e-12 * spacing,
+            max_steps: 200 * s.outputs + 20_000,
+            pos: 0.0,
+            h: spacing,
+            h_prev: 0.0,
+            k_out: 1,
+            dissipating: false,
+            quick_fallback: false,
+            tau: 0.0,
+            last: None,
+            dc_last: 0.0,
+            overshoots: 0,
+        }
+    }
+
+    /// Back to displacement control after a forward dissipation step or a jump.
+    fn resume_displacement(&mut self) {
+        self.dissipating = false;
+        self.quick_fallback = true;
+        self.h = (0.5 * self.spacing).max(self.h_min);
+        self.h_prev = 0.0;
+    }
+}
+
+/// The whole-mesh solver's state: the problem, Newton, the committed solution and what has been
+/// recorded of it.
+struct WholeMesh<'a> {
+    p: &'a FeProblem,
+    law: &'a dyn CohesiveLaw,
+    s: &'a PathSettings,
+    o: &'a RunOptions,
+    nw: Newton,
+    segments: bool,
+    /// Steps double after convergence in at most `grow_below` iterations and halve from
+    /// `shrink_above` on.
+    grow_below: usize,
+    shrink_above: usize,
+    mode_one: Option<super::segment::ModeOne>,
+    cur: State,
+    prev_q: Vec<f64>,
+    trial: Vec<f64>,
+    /// Law states before the last commit (segments: the work is integrated along the gap path).
+    before: Vec<LawState>,
+    ledger: Ledger,
+    stats: RunStats,
+    rows: Vec<StepRow>,
+    measures: Measures,
+    /// Dissipated energy at the last commit, and the last positive increment of it (the released
+    /// energy a dissipation step starts from).
+    last_diss: f64,
+    tau_hint: f64,
+    front: FrontTrack,
+}
+
+/// Work arrays of the crack measures.
+struct Measures {
+    cohesive: Vec<usize>,
+    xs: Vec<f64>,
+    dmg: Vec<f64>,
+    all_damage: Vec<f64>,
+    point_stored: Vec<f64>,
+    scratch: Vec<f64>,
+}
+
+impl<'a> WholeMesh<'a> {
+    fn new(
+        p: &'a FeProblem,
+        law: &'a dyn CohesiveLaw,
+        s: &'a PathSettings,
+        o: &'a RunOptions,
+        fallback: Option<&'static str>,
+    ) -> Self {
+        let mut nw = Newton::with_rule(p, law, s.newton, o.interface);
+        // With segments, forces are continuous and a good predictor leaves Newton in its basin: the
+        // branch-cycling safeguard of the nodal rule only slows it down.
+        nw.safeguard = o.interface == InterfaceRule::Nodal;
+        let segments = o.interface == InterfaceRule::Segments;
+        // Steps double after convergence in at most this many iterations. With segments a crack front
+        // crossing many points per step is normal work for Newton (typically 4-5 quadratically
+        // converging iterations), not a sign that the step is too long.
+        let (grow_below, shrink_above) = if segments { (5, 9) } else { (3, 7) };
+        let mode_one = if segments { super::segment::ModeOne::of(law) } else { None };
+        let n = nw.asm.n();
+        let np = p.points.len();
+        let cohesive: Vec<usize> = (0..np).filter(|&i| p.points[i].kind == PointKind::Cohesive).collect();
+        let xs: Vec<f64> = cohesive.iter().map(|&i| p.mesh.x[p.points[i].node]).collect();
+        let measures = Measures {
+            dmg: vec![0.0; cohesive.len()],
+            all_damage: vec![0.0; np],
+            point_stored: vec![0.0; np],
+            scratch: vec![0.0; cohesive.len()],
+            cohesive,
+            xs,
+        };
+        let init = law.initial_state();
+        WholeMesh {
+            p,
+            law,
+            s,
+            o,
+            nw,
+            segments,
+            grow_below,
+            shrink_above,
+            mode_one,
+            cur: State { q: vec![0.0; n], states: vec![init; np], reaction: 0.0 },
+            prev_q: vec![0.0; n],
+            trial: vec![0.0; n],
+            before: Vec::new(),
+            ledger: Ledger::new(np),
+            stats: RunStats { window_fallback: fallback, ..Default::default() },
+            rows: vec![StepRow {
+                crack: CrackMeasures { tip: s.crack_origin, ..Default::default() },
+                ..Default::default()
+            }],
+            measures,
+            last_diss: 0.0,
+            tau_hint: 0.0,
+            front: FrontTrack::default(),
+        }
+    }
+
+    /// The run's failure with every row recorded so far.
+    fn fail(&mut self, msg: String) -> PathFailure {
+        PathFailure { error: CzError::Simulation(msg), rows: std::mem::take(&mut self.rows) }
+    }
+
+    fn finish(mut self) -> (Vec<StepRow>, RunStats) {
+        self.stats.assemblies = self.nw.counters.0;
+        self.stats.factorizations = self.nw.counters.1;
+        (self.rows, self.stats)
+    }
+
+    /// One step under displacement control towards the next output abscissa; on failure, a
+    /// shorter step or the switch to dissipation control.
+    fn displacement_step(&mut self, c: &mut Control) -> Result<(), PathFailure> {
+        let (p, law, s, ic) = (self.p, self.law, self.s, self.p.control);
+        while c.k_out < s.outputs && c.spacing * c.k_out as f64 <= c.pos + c.eps {
+            c.k_out += 1;
+        }
+        let next = if c.k_out >= s.outputs { c.target } else { c.spacing * c.k_out as f64 };
+        let dh = c.h.min(next - c.pos);
+        // Predictor: extrapolate the last increment.
+        let alpha = if c.h_prev > 0.0 { dh / c.h_prev } else { 0.0 };
+        for i in 0..self.trial.len() {
+            self.trial[i] = self.cur.q[i] + alpha * (self.cur.q[i] - self.prev_q[i]);
+        }
+        if let Some(da) = self.front.advance(c.dir * dh) {
+            shift_predictor(p, &self.cur.q, &mut self.trial, self.front.x, da, self.front.zone());
+        }
+        self.trial[ic] = c.dir * (c.pos + dh);
+        match self.nw.solve_displacement(p, law, &self.cur.states, &mut self.trial) {
+            Ok(it) => {
+                let reaction = self.nw.f[ic];
+                let lands = (next - (c.pos + dh)).abs() <= c.eps;
+                self.commit(reaction, !self.o.outputs_only || lands);
+                c.pos = if (next - (c.pos + dh)).abs() <= c.eps { next } else { c.pos + dh };
+                c.h_prev = dh;
+                c.quick_fallback = false;
+                if it <= self.grow_below {
+                    c.h = (2.0 * c.h).min(c.spacing);
+                } else if it >= self.shrink_above {
+                    c.h *= 0.5;
+                }
+            }
+            Err(e) => {
+                self.stats.cuts += 1;
+                c.h = 0.5 * dh;
+                if c.h >= c.h_min && !c.quick_fallback {
+                    return Ok(());
+                }
+                // Snap-back (or a genuinely hard step): follow the path by dissipation. That
+                // needs a loaded, dissipating state; without one no snap-back is possible and
+                // the failure is genuine.
+                if !(self.tau_hint > 0.0 && self.cur.reaction != 0.0 && self.cur.q[ic] != 0.0) {
+                    let msg = format!(
+                        "no convergence at control {:.6} ({e:?}) even with steps of {:.3e}, and nothing has \
+                         dissipated yet, so no snap-back to follow",
+                        c.dir * (c.pos + dh),
+                        dh
+                    );
+                    return Err(self.fail(msg));
+                }
+                c.dissipating = true;
+                if c.tau <= 0.0 || !c.quick_fallback {
+                    c.tau = self.tau_hint;
+                }
+                c.last = None;
+            }
+        }
+        Ok(())
+    }
+
+    /// One step under the dissipation constraint (through a snap-back); when it cannot be met
+    /// even with tiny increments, a jump over the unstable stretch.
+    fn dissipation_step(&mut self, c: &mut Control) -> Result<(), PathFailure> {
+        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let c0 = self.cur.q[ic];
+        let l0 = self.cur.reaction;
+        // Do not jump past the target: the run must end exactly on it.
+        let tau_try = if c.dc_last > 0.0 && c.pos + c.dc_last * 1.5 > c.target {
+            c.tau * (0.5 * (c.target - c.pos) / c.dc_last).clamp(0.05, 1.0)
+        } else {
+            c.tau
+        };
+        let mut lam = l0;
+        self.trial.copy_from_slice(&self.cur.q);
+        if let Some((dl_prev, tau_prev)) = c.last {
+            let beta = tau_try / tau_prev;
+            for i in 0..self.trial.len() {
+                self.trial[i] += beta * (self.cur.q[i] - self.prev_q[i]);
+            }
+            lam += beta * dl_prev;
+        }
+        match self.nw.solve_dissipation(p, law, &self.cur.states, &mut self.trial, &mut lam, c0, l0, tau_try) {
+            Ok(_) if c.dir * self.trial[ic] > c.target + c.eps && c.overshoots < 3 => {
+                // Would end beyond the target: retry with a smaller increment so the run ends
+                // on the target under displacement control. If the target lies inside a
+                // snap-back no forward step can stop there; the run then ends just beyond it.
+                c.tau *= 0.25;
+                c.last = None;
+                c.overshoots += 1;
+                self.stats.cuts += 1;
+            }
+            Ok(it) => {
+                self.commit(lam, true);
+                self.stats.dissipation_steps += 1;
+                c.last = Some((lam - l0, tau_try));
+                let dc = (self.cur.q[ic] - c0).abs();
+                c.dc_last = dc * tau_ratio_guard(c.dir * (self.cur.q[ic] - c0));
+                c.pos = c.dir * self.cur.q[ic];
+                // Aim at steps of about half the output spacing in the control.
+                if it <= 4 && dc > 0.0 {
+                    c.tau *= (0.5 * c.spacing / dc).clamp(0.5, 2.0);
+                } else if it >= self.shrink_above {
+                    c.tau *= 0.6;
+                }
+                // Stay on dissipation control while the crack runs (each node that fails is a
+                // small snap-back for displacement control); return to displacement control to
+                // end exactly at the target, or when nothing dissipates any more.
+                // With segments a snap-back is genuine, not one per point: go back to
+                // displacement control after every forward step.
+                let near_end = c.pos + c.spacing >= c.target;
+                if c.dir * (self.cur.q[ic] - c0) > 0.0 && (near_end || self.segments) {
+                    c.resume_displacement();
+                }
+            }
+            Err(_) => {
+                self.stats.cuts += 1;
+                c.tau *= 0.5;
+                c.last = None;
+                if c.tau < 1e-12 * self.ledger.external_work.abs().max(1e-300) {
+                    return self.jump_over(c);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Last resort when the dissipation constraint cannot be met: jump over the unstable stretch
+    /// under displacement control (the states recorded are still equilibria; the skipped part is
+    /// not).
+    fn jump_over(&mut self, c: &mut Control) -> Result<(), PathFailure> {
+        let (p, law, ic) = (self.p, self.law, self.p.control);
+        for k in 1..=4 {
+            // (may end beyond the target when it lies inside the unstable stretch)
+            let dh = 0.5 * c.spacing * k as f64;
+            self.trial.copy_from_slice(&self.cur.q);
+            self.trial[ic] = c.dir * (c.pos + dh);
+            if self.nw.solve_displacement(p, law, &self.cur.states, &mut self.trial).is_ok() {
+                let reaction = self.nw.f[ic];
+                self.commit(reaction, true);
+                c.pos += dh;
+                c.resume_displacement();
+                c.tau = self.tau_hint.max(c.tau);
+                return Ok(());
+            }
+        }
+        let msg = format!(
+            "no convergence at control {:.6}: displacement control failed and the dissipation \
+             constraint could not be met with increments down to {:.3e} N·mm",
+            c.dir * c.pos,
+            c.tau
+        );
+        Err(self.fail(msg))
+    }
+
+    /// Accepts the trial solution with `reaction` as its load: law states, energy ledger and
+    /// front track move on; with `record`, a row is written.
+    fn commit(&mut self, reaction: f64, record: bool) {
+        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let c_old = self.cur.q[ic];
+        let r_old = self.cur.reaction;
+        self.prev_q.copy_from_slice(&self.cur.q);
+        self.cur.q.copy_from_slice(&self.trial);
+        if self.segments {
+            self.before.clone_from(&self.cur.states);
+        }
+        for (st, ev) in self.cur.states.iter_mut().zip(&self.nw.asm.trial) {
+            *st = ev.state;
+        }
+        self.cur.reaction = reaction;
+        let (t, g) = (&self.nw.asm.trial, &self.nw.asm.gaps);
+        if self.segments {
+            let dc = self.cur.q[ic] - c_old;
+            self.ledger.commit_along(&p.points, law, &self.before, t, g, dc, r_old, reaction, self.mode_one.as_ref());
+        } else {
+            self.ledger.commit(&p.points, t, g, self.cur.q[ic] - c_old, r_old, reaction);
+        }
+        let stored = energy::interface_stored(&p.points, law, &self.cur.states, t, g);
+        let dissipated = self.ledger.interface_work - stored;
+        // With segments the recoverable energy is integrated like the forces (the dissipation
+        // stays point by point, where the work is integrated).
+        let stored = if self.segments {
+            for (i, v) in self.measures.point_stored.iter_mut().enumerate() {
+                let g = &self.nw.asm.gaps[i];
+                *v = match p.points[i].kind {
+                    PointKind::Cohesive => law.stored_energy(g, &self.cur.states[i]),
+                    PointKind::Contact => 0.5 * self.nw.asm.trial[i].traction.dot(g),
+                };
+            }
+            self.nw.asm.interface_stored(p, &self.measures.point_stored)
+        } else {
+            stored
+        };
+        if dissipated - self.last_diss > 0.0 {
+            self.tau_hint = dissipated - self.last_diss;
+        }
+        self.last_diss = dissipated;
+        self.stats.steps += 1;
+        if self.segments {
+            self.front.commit(self.cur.q[ic], &self.nw.asm.segments, &self.nw.asm.fronts);
+        }
+        if record {
+            let structural = self.nw.asm.structural_energy(p, &self.cur.q);
+            let crack = self.crack_measures();
+            self.rows.push(StepRow {
+                control: self.cur.q[ic],
+                reaction,
+                external_work: self.ledger.external_work,
+                elastic_energy: structural + stored,
+                dissipated_energy: dissipated,
+                crack,
+            });
+        }
+    }
+
+    /// Debonded length, process zone and tip of the committed state: from the segments' fronts
+    /// (segment rule) or from the points' damage (nodal rule).
+    fn crack_measures(&mut self) -> CrackMeasures {
+        let (law, s, m) = (self.law, self.s, &mut self.measures);
+        if self.segments {
+            for (d, st) in m.all_damage.iter_mut().zip(&self.cur.states) {
+                *d = st.damage;
+            }
+            let (segs, gaps, st) = (&self.nw.asm.segments, &self.nw.asm.gaps, &self.cur.states);
+            let level = |k: usize| {
+                let sg = &segs[k];
+                super::segment::level_front(law, gaps[sg.a], gaps[sg.b], &st[sg.a], &st[sg.b], s.damage_threshold)
             };
-            let mut lam = l0;
-            trial.copy_from_slice(&cur.q);
-            if let Some((dl_prev, tau_prev)) = last {
-                let beta = tau_try / tau_prev;
-                for i in 0..n {
-                    trial[i] += beta * (cur.q[i] - prev_q[i]);
-                }
-                lam += beta * dl_prev;
+            let all_damage = &m.all_damage;
+            crack::from_segments(
+                segs,
+                &self.nw.asm.fronts,
+                |i| all_damage[i],
+                s.crack_origin,
+                s.damage_threshold,
+                level,
+            )
+        } else {
+            for (d, &i) in m.dmg.iter_mut().zip(&m.cohesive) {
+                *d = self.cur.states[i].damage;
             }
-            match nw.solve_dissipation(p, law, &cur.states, &mut trial, &mut lam, c0, l0, tau_try) {
-                Ok(_) if dir * trial[ic] > target + eps && overshoots < 3 => {
-                    // Would end beyond the target: retry with a smaller increment so the run ends
-                    // on the target under displacement control. If the target lies inside a
-                    // snap-back no forward step can stop there; the run then ends just beyond it.
-                    tau *= 0.25;
-                    last = None;
-                    overshoots += 1;
-                    stats.cuts += 1;
-                }
-                Ok(it) => {
-                    commit!(lam, true);
-                    stats.dissipation_steps += 1;
-                    last = Some((lam - l0, tau_try));
-                    let dc = (cur.q[ic] - c0).abs();
-                    dc_last = dc * tau_ratio_guard(dir * (cur.q[ic] - c0));
-                    pos = dir * cur.q[ic];
-                    // Aim at steps of about half the output spacing in the control.
-                    if it <= 4 && dc > 0.0 {
-                        tau *= (0.5 * spacing / dc).clamp(0.5, 2.0);
-                    } else if it >= shrink_above {
-                        tau *= 0.6;
-                    }
-                    // Stay on dissipation control while the crack runs (each node that fails is a
-                    // small snap-back for displacement control); return to displacement control to
-                    // end exactly at the target, or when nothing dissipates any more.
-                    // With segments a snap-back is genuine, not one per point: go back to
-                    // displacement control after every forward step.
-                    let near_end = pos + spacing >= target;
-                    if dir * (cur.q[ic] - c0) > 0.0 && (near_end || segments) {
-                        dissipating = false;
-                        quick_fallback = true;
-                        h = (0.5 * spacing).max(h_min);
-                        h_prev = 0.0;
-                    }
-                }
-                Err(_) => {
-                    stats.cuts += 1;
-                    tau *= 0.5;
-                    last = None;
-                    if tau < 1e-12 * ledger.external_work.abs().max(1e-300) {
-                        // Last resort: jump over the unstable stretch under displacement control
-                        // (the states recorded are still equilibria; the skipped part is not).
-                        let mut jumped = false;
-                        for k in 1..=4 {
-                            // (may end beyond the target when it lies inside the unstable stretch)
-                            let dh = 0.5 * spacing * k as f64;
-                            trial.copy_from_slice(&cur.q);
-                            trial[ic] = dir * (pos + dh);
-                            if nw.solve_displacement(p, law, &cur.states, &mut trial).is_ok() {
-                                let reaction = nw.f[ic];
-                                commit!(reaction, true);
-                                pos += dh;
-                                jumped = true;
-                                break;
-                            }
-                        }
-                        if jumped {
-                            dissipating = false;
-                            quick_fallback = true;
-                            h = (0.5 * spacing).max(h_min);
-                            h_prev = 0.0;
-                            tau = tau_hint.max(tau);
-                            continue;
-                        }
-                        let msg = format!(
-                            "no convergence at control {:.6}: displacement control failed and the dissipation \
-                             constraint could not be met with increments down to {tau:.3e} N·mm",
-                            dir * pos
-                        );
-                        return Err(fail(rows, msg));
-                    }
-                }
-            }
+            crack::measure(&m.xs, &m.dmg, s.damage_threshold, s.crack_origin, &mut m.scratch)
         }
-    }
-    stats.assemblies = nw.counters.0;
-    stats.factorizations = nw.counters.1;
-    Ok((rows, stats))
-}
-
-/// The most advanced onset front of the segment rule over the last two commits, for predicting
-/// how far it moves in the next step.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct FrontTrack {
-    /// Control and front position at the previous and the last commit (NaN: no front).
-    hist: [(f64, f64); 2],
-    /// Front position at the last commit.
-    pub(crate) x: f64,
-    /// Distance between the onset and the failure front (or the crack origin) at the last commit.
-    zone_length: f64,
-    /// Length of the segment holding the front.
-    element: f64,
-    known: usize,
-}
-
-impl FrontTrack {
-    pub(crate) fn commit(&mut self, control: f64, segments: &[super::segment::Segment], fronts: &[[Option<f64>; 2]]) {
-        let (mut onset, mut failure, mut element) = (f64::NAN, f64::NAN, 0.0);
-        for (sg, fr) in segments.iter().zip(fronts) {
-            if let Some(e) = fr[0] {
-                onset = sg.x + e * sg.len;
-                element = sg.len;
-            }
-            if let Some(e) = fr[1] {
-                failure = sg.x + e * sg.len;
-            }
-        }
-        self.hist = [self.hist[1], (control, onset)];
-        self.known = if onset.is_finite() { (self.known + 1).min(2) } else { 0 };
-        self.x = onset;
-        self.element = element;
-        self.zone_length = if failure.is_finite() { (onset - failure).abs() } else { 0.0 };
-    }
-
-    /// Front advance over a control increment `dc`, extrapolated from the last two commits.
-    pub(crate) fn advance(&self, dc: f64) -> Option<f64> {
-        let [(c0, x0), (c1, x1)] = self.hist;
-        (self.known == 2 && c1 != c0).then(|| (x1 - x0) / (c1 - c0) * dc)
-    }
-
-    /// Half-width of the region that travels with the front: the process zone and the elastic
-    /// region ahead of it where the gaps are still large (a few process zones), at least a few
-    /// elements.
-    pub(crate) fn zone(&self) -> f64 {
-        (4.0 * self.zone_length).max(20.0 * self.element)
     }
 }
 

@@ -38,7 +38,7 @@ use super::crack::CrackMeasures;
 use super::energy::path_work;
 use super::interface::{self, PointKind};
 use super::mesh::NONE;
-use super::path::{PathSettings, RunStats, StepRow};
+use super::run_types::{FrontTrack, PathSettings, RunStats, StepRow};
 use super::segment::{self, End, ModeOne, Segment};
 
 /// Largest number of unknowns per node the window handles.
@@ -1270,7 +1270,7 @@ impl<'a, const D: usize> Solver<'a, D> {
         let mut h_prev = 0.0f64;
         let mut k_out = 1usize;
         let mut external = 0.0f64;
-        let mut front = super::path::FrontTrack::default();
+        let mut front = FrontTrack::default();
         let mut states: Vec<LawState> = self.pts.iter().map(|r| r.state).collect();
         let mut saved_q = vec![[0.0; D]; self.q.len()];
         // Last node with sizeable gaps at the last commit.

@@ -119,7 +119,7 @@ use super::spec::FrpBeamSpec;
 use crate::beamtest::{self, ControlSettings, RowScale};
 use crate::fe::mesh::{graded, NONE};
 use crate::fe::newton::Newton;
-use crate::fe::path::StepRow;
+use crate::fe::run_types::StepRow;
 use crate::fe::{
     self, FeProblem, InterfacePoint, Layer, Mesh, NewtonSettings, PathSettings, PointKind, Section, Spring,
 };

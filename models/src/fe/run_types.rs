@@ -1,0 +1,144 @@
+//! What a path-following run is asked and what it returns, shared by the whole-mesh solver
+//! ([`super::path`]) and the window solver (`super::window`): the settings of the path, the
+//! recorded rows, the run's statistics and failure, and the tracking of the crack front that
+//! both use to predict the next step. The types live apart from either solver so that neither
+//! depends on the other's module (the whole-mesh solver calls the window; the window only needs
+//! these types).
+
+use czid_core::CzError;
+
+use super::assembly::InterfaceRule;
+use super::crack::CrackMeasures;
+use super::newton::NewtonSettings;
+use super::segment::Segment;
+
+/// How far and how finely to follow the path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathSettings {
+    /// Final value of the control unknown (either sign).
+    pub target: f64,
+    /// Number of equally spaced output abscissae between 0 and `target` (all are hit exactly).
+    pub outputs: usize,
+    /// Smallest displacement step, as a fraction of the output spacing, before switching to
+    /// dissipation control.
+    pub min_step_fraction: f64,
+    /// Damage at or above which a point counts as fully debonded.
+    pub damage_threshold: f64,
+    /// Position of the initial crack front (reported as the tip until something debonds).
+    pub crack_origin: f64,
+    /// Newton settings.
+    pub newton: NewtonSettings,
+}
+
+/// One converged state, in the units of the simulated part (not yet scaled by symmetry).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepRow {
+    /// Control unknown.
+    pub control: f64,
+    /// Its reaction (work-conjugate generalised force).
+    pub reaction: f64,
+    /// Work of the reaction so far.
+    pub external_work: f64,
+    /// Strain energy of beams, springs and the interface's recoverable part.
+    pub elastic_energy: f64,
+    /// Energy dissipated by the interface so far.
+    pub dissipated_energy: f64,
+    /// Debonded length, process zone and tip along the cohesive points.
+    pub crack: CrackMeasures,
+}
+
+/// Statistics of a run, for profiling and tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RunStats {
+    /// Converged steps.
+    pub steps: usize,
+    /// Assemblies (Newton iterations including the final residual check).
+    pub assemblies: usize,
+    /// LU factorisations.
+    pub factorizations: usize,
+    /// Steps that had to be cut.
+    pub cuts: usize,
+    /// Dissipation-controlled steps.
+    pub dissipation_steps: usize,
+    /// Whether the run was solved on a window around the crack front ([`RunOptions::window`]).
+    pub windowed: bool,
+    /// Why a run asked to use the window was solved on the whole mesh instead.
+    pub window_fallback: Option<&'static str>,
+}
+
+/// A failed run: the error and the converged rows.
+#[derive(Clone, Debug)]
+pub struct PathFailure {
+    /// What went wrong.
+    pub error: CzError,
+    /// Rows that converged before it.
+    pub rows: Vec<StepRow>,
+}
+
+/// Choices of a run beyond the path itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RunOptions {
+    /// How the interface is integrated. With [`InterfaceRule::Segments`] the crack measures come
+    /// from the segments' fronts and each point's work is integrated along its gap path by the law
+    /// ([`super::energy::Ledger::commit_along`]).
+    pub interface: InterfaceRule,
+    /// Record only the output abscissae (and the states followed under the dissipation constraint,
+    /// where the output grid cannot be followed) instead of every converged step. Then the rows'
+    /// abscissae do not depend on the parameters, so a response interpolated between them is as
+    /// smooth in the parameters as the states themselves.
+    pub outputs_only: bool,
+    /// Solve only a window around the crack front, the linear regions behind and ahead of it
+    /// condensed exactly (`fe::window`), when the problem fits (small rotations, segments,
+    /// one interface from near the loaded end to the far end, a law linear near the origin); any
+    /// other problem, or a run whose checks fail, is solved on the whole mesh. Records the output
+    /// abscissae only.
+    pub window: bool,
+}
+
+/// The most advanced onset front of the segment rule over the last two commits, for predicting
+/// how far it moves in the next step.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct FrontTrack {
+    /// Control and front position at the previous and the last commit (NaN: no front).
+    hist: [(f64, f64); 2],
+    /// Front position at the last commit.
+    pub(crate) x: f64,
+    /// Distance between the onset and the failure front (or the crack origin) at the last commit.
+    zone_length: f64,
+    /// Length of the segment holding the front.
+    element: f64,
+    known: usize,
+}
+
+impl FrontTrack {
+    pub(crate) fn commit(&mut self, control: f64, segments: &[Segment], fronts: &[[Option<f64>; 2]]) {
+        let (mut onset, mut failure, mut element) = (f64::NAN, f64::NAN, 0.0);
+        for (sg, fr) in segments.iter().zip(fronts) {
+            if let Some(e) = fr[0] {
+                onset = sg.x + e * sg.len;
+                element = sg.len;
+            }
+            if let Some(e) = fr[1] {
+                failure = sg.x + e * sg.len;
+            }
+        }
+        self.hist = [self.hist[1], (control, onset)];
+        self.known = if onset.is_finite() { (self.known + 1).min(2) } else { 0 };
+        self.x = onset;
+        self.element = element;
+        self.zone_length = if failure.is_finite() { (onset - failure).abs() } else { 0.0 };
+    }
+
+    /// Front advance over a control increment `dc`, extrapolated from the last two commits.
+    pub(crate) fn advance(&self, dc: f64) -> Option<f64> {
+        let [(c0, x0), (c1, x1)] = self.hist;
+        (self.known == 2 && c1 != c0).then(|| (x1 - x0) / (c1 - c0) * dc)
+    }
+
+    /// Half-width of the region that travels with the front: the process zone and the elastic
+    /// region ahead of it where the gaps are still large (a few process zones), at least a few
+    /// elements.
+    pub(crate) fn zone(&self) -> f64 {
+        (4.0 * self.zone_length).max(20.0 * self.element)
+    }
+}
