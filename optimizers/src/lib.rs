@@ -37,4 +37,4 @@ pub use local::{GaussNewton, Lbfgs, LevenbergMarquardt, LocalOptimizer, LocalSet
 pub use miga::{Miga, MigaSettings};
 pub use nsga2::{Nsga2, Nsga2Settings};
 pub use observers::{CsvHistory, Observers, ProgressBar};
-pub use registry::{optimizer_from_config, optimizer_from_table, OPTIMIZER_NAMES};
+pub use registry::{method_from_config, optimizer_from_config, optimizer_from_table, Method, REGISTRY};

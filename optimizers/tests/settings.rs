@@ -2,7 +2,7 @@
 
 use czid_core::{Budget, CzError, NoObserver};
 use czid_optimizers::testfns::by_name;
-use czid_optimizers::{optimizer_from_config, optimizer_from_table, MigaSettings, OPTIMIZER_NAMES};
+use czid_optimizers::{optimizer_from_config, optimizer_from_table, MigaSettings, REGISTRY};
 
 fn table(s: &str) -> toml::Value {
     toml::from_str(s).unwrap()
@@ -14,9 +14,9 @@ fn err_of(name: &str, s: &str) -> CzError {
 
 #[test]
 fn every_registered_name_builds_with_defaults() {
-    for name in OPTIMIZER_NAMES {
-        let opt = optimizer_from_config(name, &table("")).unwrap();
-        assert_eq!(opt.name(), *name);
+    for entry in REGISTRY {
+        let opt = optimizer_from_config(entry.name, &table("")).unwrap();
+        assert_eq!(opt.name(), entry.name);
     }
     assert_eq!(optimizer_from_config("lm", &table("")).unwrap().name(), "levenberg-marquardt");
 }

@@ -9,7 +9,7 @@ use crate::problem_file::LoadedProblem;
 use czid_core::{columns, Budget, CzError, Evaluation, Observer, OptimizationResult, Problem, Progress, Result};
 use czid_optimizers::checkpoint::CheckpointWriter;
 use czid_optimizers::observers::{CsvHistory, Observers, ProgressBar};
-use czid_optimizers::registry::{local_from_config, optimizer_from_config};
+use czid_optimizers::registry::{method_from_config, Method};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -121,8 +121,6 @@ impl Observer for StopFlag {
     }
 }
 
-const LOCAL: &[&str] = &["nelder-mead", "lbfgs", "gauss-newton", "levenberg-marquardt", "lm"];
-
 /// One optimisation run and what it cost.
 pub struct Run {
     /// The optimizer's result (unit-cube coordinates).
@@ -146,18 +144,18 @@ pub fn optimize(
 ) -> Result<Run> {
     let timed = Timed { inner: id, nanos: AtomicU64::new(0) };
     let start = Instant::now();
-    let result = if LOCAL.contains(&name) {
-        if resume.is_some() {
+    let result = match method_from_config(name, settings)? {
+        Method::Local(_) if resume.is_some() => {
             return Err(CzError::config("--resume", format!("`{name}` cannot resume; run it again")));
         }
-        let u0 = id.space().to_unit(&id.initial()?);
-        local_from_config(name, settings)?.minimize_from(&timed, budget, &u0, observer)?
-    } else {
-        let optimizer = optimizer_from_config(name, settings)?;
-        match resume {
+        Method::Local(local) => {
+            let u0 = id.space().to_unit(&id.initial()?);
+            local.minimize_from(&timed, budget, &u0, observer)?
+        }
+        Method::Global(optimizer) => match resume {
             Some(state) => optimizer.resume(&timed, budget, state, observer)?,
             None => optimizer.minimize(&timed, budget, seed, observer)?,
-        }
+        },
     };
     Ok(Run {
         result,
