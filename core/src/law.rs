@@ -101,6 +101,23 @@ pub trait CohesiveLaw: Send + Sync + std::fmt::Debug {
     fn stored_energy(&self, gap: &Gap, state: &LawState) -> f64 {
         0.5 * self.evaluate(gap, state).traction.dot(gap)
     }
+
+    /// Damage at which the crack that an observer sees lies, when that is not complete failure
+    /// (default `None`: the visible crack is where the law has failed completely). A law whose
+    /// damage reaches 1 only long after the visible crack has passed (fibres still bridging
+    /// behind a matrix crack) returns the damage of its visible front, and a forward model that
+    /// records a crack length places the front there.
+    fn visible_front_damage(&self) -> Option<f64> {
+        None
+    }
+
+    /// The law with a fibre-bridging tail added (an R-curve): a long, weak part of strength
+    /// `strength` (MPa) that vanishes at opening `opening` (mm), superposed on this law; `None`
+    /// when the law has no such extension (default). At `strength = 0` the law itself.
+    fn with_bridging_tail(&self, strength: f64, opening: f64) -> Option<Result<Box<dyn CohesiveLaw>>> {
+        let _ = (strength, opening);
+        None
+    }
 }
 
 /// Reads a law from TOML (a table with a `type` key) and validates it.

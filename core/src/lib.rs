@@ -13,20 +13,27 @@
 //! * [`ParameterSpace`]: named parameters with units, bounds and optional log scale, mapping an
 //!   optimizer's vector onto a configured law or model and back.
 //! * [`Optimizer`] and [`Problem`]: the contract between search methods and what they minimise.
+//! * [`EffectDeclaration`] and [`RegimeRule`]: what a forward model declares about itself for
+//!   the diagnosis of the sim-to-real gap (its switchable effects, the regimes of its tests);
+//!   [`noise`] estimates measurement noise from the data alone.
 //!
 //! Units are N, mm and MPa (N/mm²) throughout; energies per unit area are N/mm.
 
 pub mod curve;
+pub mod effect;
 pub mod error;
 pub mod law;
 pub mod model;
+pub mod noise;
 pub mod objective;
 pub mod optimizer;
 pub mod param;
 pub mod record;
+pub mod regimes;
 pub mod response;
 
 pub use curve::Curve;
+pub use effect::{EffectDeclaration, EffectKind, EffectScope, Sign, Typical};
 pub use error::{CzError, Result};
 pub use law::{law_from_toml, law_to_toml, CohesiveLaw, Gap, LawEval, LawState, ParameterInfo, Tangent, Traction};
 pub use model::{ForwardModel, SimulationFailure};
@@ -36,4 +43,5 @@ pub use optimizer::{
 };
 pub use param::{Parameter, ParameterSpace, Scale};
 pub use record::{columns, Column, Record};
+pub use regimes::{GenericRegimes, RegimeRule, Span};
 pub use response::{ColumnResponse, Response};

@@ -1,8 +1,10 @@
 //! The forward-model contract.
 
+use crate::effect::EffectDeclaration;
 use crate::error::CzError;
 use crate::law::CohesiveLaw;
 use crate::record::Record;
+use crate::regimes::{GenericRegimes, RegimeRule};
 
 /// A simulation that failed part way: the error, and the steps that did converge.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,6 +29,9 @@ impl std::error::Error for SimulationFailure {}
 /// passed per run so that an identification can try thousands of laws on one model (which may
 /// cache its mesh and symbolic factorisation across runs, in fields marked `#[serde(skip)]`).
 ///
+/// A model also declares what the diagnosis needs to know about it: its switchable effects
+/// ([`ForwardModel::effects`]) and how its tests split into regimes ([`ForwardModel::regimes`]).
+///
 /// Like laws, models are registered with `typetag`, so a problem file names one by
 /// `type = "..."` and users add their own with `#[typetag::serde(name = "my_test")]`.
 #[typetag::serde(tag = "type")]
@@ -42,4 +47,17 @@ pub trait ForwardModel: Send + Sync + std::fmt::Debug {
     /// Runs the test with `law`; returns one row per converged step with at least the columns
     /// of [`crate::columns`] that the model measures.
     fn simulate(&self, law: &dyn CohesiveLaw) -> Result<Record, SimulationFailure>;
+
+    /// The model's switchable effects (default: none). Each declared field must exist in the
+    /// model's configuration, and at the declared null value the model must simulate exactly as
+    /// without the effect; the diagnosis builds its candidate effects from these declarations.
+    fn effects(&self) -> Vec<EffectDeclaration> {
+        Vec::new()
+    }
+
+    /// How the model's tests split into regimes (default: the generic rule of a test that loads,
+    /// peaks and softens).
+    fn regimes(&self) -> &'static dyn RegimeRule {
+        &GenericRegimes
+    }
 }

@@ -171,7 +171,8 @@ impl ParameterSpace {
         Ok(())
     }
 
-    /// A copy of `base` with each parameter's path set to the physical value in `x`.
+    /// A copy of `base` with each parameter's path set to the physical value in `x`. A path that
+    /// leads to a boolean (a switch) is set on for values of 0.5 and more, off below.
     pub fn apply<T: Serialize + DeserializeOwned>(&self, base: &T, x: &[f64]) -> Result<T> {
         if x.len() != self.params.len() {
             return Err(CzError::config(
@@ -185,13 +186,14 @@ impl ParameterSpace {
                 .map(Value::Number)
                 .ok_or_else(|| CzError::invalid(format!("parameter `{}`", p.path), "value", v, "must be finite"))?;
             for slot in lookup(&mut tree, &p.path)? {
-                *slot = number.clone();
+                *slot = if slot.is_boolean() { Value::Bool(v >= 0.5) } else { number.clone() };
             }
         }
         serde_json::from_value(tree).map_err(|e| CzError::config("parameters", e.to_string()))
     }
 
-    /// The current physical values of the parameters in `config`.
+    /// The current physical values of the parameters in `config` (a switch reads 1 when on, 0 when
+    /// off).
     pub fn read<T: Serialize>(&self, config: &T) -> Result<Vec<f64>> {
         let mut tree = serde_json::to_value(config).map_err(|e| CzError::config("parameters", e.to_string()))?;
         self.params
@@ -200,7 +202,11 @@ impl ParameterSpace {
                 let owner = || format!("parameter `{}`", p.path);
                 let values = lookup(&mut tree, &p.path)?
                     .into_iter()
-                    .map(|v| v.as_f64().ok_or_else(|| CzError::config(owner(), "path does not lead to a number")))
+                    .map(|v| {
+                        v.as_f64()
+                            .or_else(|| v.as_bool().map(f64::from))
+                            .ok_or_else(|| CzError::config(owner(), "path does not lead to a number"))
+                    })
                     .collect::<Result<Vec<f64>>>()?;
                 // A wildcard ties several values to one parameter: they must start equal.
                 if values.iter().any(|v| *v != values[0]) {
@@ -255,6 +261,20 @@ fn lookup<'a>(tree: &'a mut Value, path: &str) -> Result<Vec<&'a mut Value>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_switch_is_a_parameter_that_is_one_when_on() {
+        #[derive(Serialize, Deserialize)]
+        struct Model {
+            large: bool,
+        }
+        let space = ParameterSpace::new(vec![Parameter::new("large", "on/off", 0.0, 1.0)]).unwrap();
+        let on: Model = space.apply(&Model { large: false }, &[1.0]).unwrap();
+        assert!(on.large);
+        assert_eq!(space.read(&on).unwrap(), vec![1.0]);
+        let off: Model = space.apply(&on, &[0.2]).unwrap();
+        assert_eq!(space.read(&off).unwrap(), vec![0.0]);
+    }
 
     #[test]
     fn inverted_bounds_are_reported() {

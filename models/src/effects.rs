@@ -6,7 +6,7 @@
 //! identification can switch it on, estimate it and take finite-difference sensitivities to it.
 
 use czid_core::error::require_non_negative;
-use czid_core::{CzError, Result};
+use czid_core::{CzError, EffectDeclaration, EffectKind, EffectScope, Result, Sign, Typical};
 use serde::{Deserialize, Serialize};
 
 /// Optional physics of a beam test. `Effects::default()` is the base model.
@@ -36,7 +36,64 @@ pub struct Effects {
     pub large_rotation: bool,
 }
 
+/// Large rotations of the arms (a switch).
+pub const LARGE_ROTATION: EffectDeclaration = EffectDeclaration {
+    name: "large_rotation",
+    description: "large rotations of the arms (geometric non-linearity at large openings)",
+    field: "effects.large_rotation",
+    unit: "on/off",
+    kind: EffectKind::Switch,
+    scope: EffectScope::Shared,
+    typical: None,
+};
+
+/// The specimen effects of a beam test (the measurement effects are in [`crate::measurement`]).
+const SPECIMEN: [EffectDeclaration; 3] = [
+    EffectDeclaration {
+        name: "root_compliance",
+        description: "root rotation at the crack front: through-thickness compliance of the arms (elastic foundation)",
+        field: "effects.root_compliance",
+        unit: "mm/MPa",
+        kind: EffectKind::Size { range: [0.0, 1e-3], null: 0.0 },
+        scope: EffectScope::Shared,
+        // 0.5–2 × h/(2 E22) for coupon arms (h/(2 E22) ≈ 2.2e-4 mm/MPa for Hartlen's specimens).
+        typical: Some(Typical { magnitude: [1.1e-4, 4.4e-4], sign: Sign::Positive }),
+    },
+    EffectDeclaration {
+        name: "crack_length_offset",
+        description: "initial crack length different from the nominal one (blunt insert, misread pre-crack)",
+        field: "effects.crack_length_offset",
+        unit: "mm",
+        kind: EffectKind::Size { range: [-5.0, 5.0], null: 0.0 },
+        scope: EffectScope::PerExperiment,
+        typical: Some(Typical { magnitude: [1.0, 4.0], sign: Sign::Either }),
+    },
+    EffectDeclaration {
+        name: "shear_compliance",
+        description: "more shear deformation of the arms than the nominal G13 gives",
+        field: "effects.shear_compliance",
+        unit: "1/MPa",
+        kind: EffectKind::Size { range: [0.0, 1e-3], null: 0.0 },
+        scope: EffectScope::Shared,
+        // An effective G13 of 30–65 % of a nominal 2.3 GPa.
+        typical: Some(Typical { magnitude: [2e-4, 8e-4], sign: Sign::Positive }),
+    },
+];
+
 impl Effects {
+    /// The switchable effects of a beam test, in the order the diagnosis lists them: large
+    /// rotations when the model supports them, the specimen's effects and the measurement's.
+    pub fn declarations(large_rotation: bool) -> Vec<EffectDeclaration> {
+        use crate::measurement::{DISPLACEMENT_OFFSET, MACHINE_COMPLIANCE};
+        let [root, crack, shear] = SPECIMEN;
+        let mut out = Vec::new();
+        if large_rotation {
+            out.push(LARGE_ROTATION);
+        }
+        out.extend([root, MACHINE_COMPLIANCE, crack, DISPLACEMENT_OFFSET, shear]);
+        out
+    }
+
     /// Checks every value, naming the field of `owner` that is invalid.
     pub fn validate(&self, owner: &str) -> Result<()> {
         require_non_negative(owner, "effects.machine_compliance", self.machine_compliance)?;

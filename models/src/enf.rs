@@ -204,6 +204,11 @@ impl ForwardModel for Enf {
         Enf::validate(self)
     }
 
+    fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
+        // The ENF model has no large-rotation option (it refuses `effects.large_rotation`).
+        crate::effects::Effects::declarations(false)
+    }
+
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
         let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
         law.validate().map_err(fail)?;

@@ -11,4 +11,5 @@ pub mod fe;
 pub mod frp;
 pub mod laws;
 pub mod materials;
+pub mod measurement;
 pub mod registry;

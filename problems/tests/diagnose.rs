@@ -33,7 +33,8 @@ fn every_bundled_dcb_candidate_at_its_null_value_is_the_base_model_exactly() {
     let reference = base.models["dcb"].simulate(base.law.as_ref()).unwrap();
     let library = Library::builtin();
     let mut checked = Vec::new();
-    for c in library.all() {
+    for c in library.all(&base) {
+        let c = c.as_ref();
         if !c.applies(&base) {
             continue;
         }
@@ -74,13 +75,14 @@ fn the_beam_candidates_apply_to_the_frp_beam_only_and_are_null_there() {
         [("beam".to_string(), Box::new(beam) as Box<dyn ForwardModel>)].into();
     let setup = Setup { law, models };
     let library = Library::builtin();
-    let applies: Vec<&str> = library.all().into_iter().filter(|c| c.applies(&setup)).map(|c| c.name()).collect();
+    let all = library.all(&setup);
+    let applies: Vec<&str> = all.iter().filter(|c| c.applies(&setup)).map(|c| c.name()).collect();
     // Bridging applies to any setup with a bilinear law; the rest are the beam's own.
     assert!(applies.len() >= 4, "{applies:?}");
     for name in ["adhesive_compliance", "shrinkage_strain", "steel_hardening", "deflection_offset"] {
         assert!(applies.contains(&name), "{name} missing from {applies:?}");
-        let c = library.select(&[name.to_string()]).unwrap()[0];
-        let s = c.apply(&setup, &nulls(c, &setup)).unwrap();
+        let c = library.select(&setup, &[name.to_string()]).unwrap().remove(0);
+        let s = c.apply(&setup, &nulls(c.as_ref(), &setup)).unwrap();
         assert_eq!(serde_json::to_value(&s).unwrap(), serde_json::to_value(&setup).unwrap(), "{name}");
         assert!(!c.applies(&dcb_setup(5.0, 5)), "{name} applies to a DCB");
     }
@@ -88,7 +90,7 @@ fn the_beam_candidates_apply_to_the_frp_beam_only_and_are_null_there() {
 
 #[test]
 fn an_unknown_candidate_is_named_with_the_known_ones() {
-    let err = Library::builtin().select(&["warp_drive".to_string()]).err().unwrap().to_string();
+    let err = Library::builtin().select(&dcb_setup(5.0, 5), &["warp_drive".to_string()]).err().unwrap().to_string();
     assert!(err.contains("unknown candidate `warp_drive`") && err.contains("machine_compliance"), "{err}");
 }
 
@@ -129,7 +131,7 @@ fn diagnose_synthetic(bridging: f64) -> czid_problems::diagnose::Diagnosis {
     let base = dcb_setup(16.0, 60);
     let library = Library::builtin();
     let truth = if bridging > 0.0 {
-        library.select(&["fibre_bridging".to_string()]).unwrap()[0].apply(&base, &[bridging, 1.0]).unwrap()
+        library.select(&base, &["fibre_bridging".to_string()]).unwrap()[0].apply(&base, &[bridging, 1.0]).unwrap()
     } else {
         base.duplicate().unwrap()
     };

@@ -2,11 +2,12 @@
 //! yielded, debonding) split where the model itself puts cracking, yield and debonding, on clean
 //! and noisy curves; a planted beam effect is named and removed, and a clean test is left alone.
 
-use czid_core::{columns, CohesiveLaw, Curve, ForwardModel, Parameter, ParameterSpace, Record};
+use czid_core::{columns, CohesiveLaw, Curve, ForwardModel, Parameter, ParameterSpace, Record, RegimeRule};
 use czid_models::frp::beam::FrpBeam;
+use czid_models::frp::regimes::{self as beam, BeamRegimes};
 use czid_problems::data::Experiment;
 use czid_problems::diagnose::gauge::{Gauge, NoiseLevels};
-use czid_problems::diagnose::regimes::{self, beam, Regime, RegimeSet};
+use czid_problems::diagnose::regimes::{self, Regime};
 use czid_problems::diagnose::run::{diagnose_subject, Diagnosis, Subject};
 use czid_problems::diagnose::{Library, Options};
 use czid_problems::identification::Setup;
@@ -28,8 +29,16 @@ fn start_of<'a>(regs: &'a [Regime], name: &str) -> Option<&'a Regime> {
     regs.iter().find(|r| r.name == name)
 }
 
+/// The beam rule's regimes of `experiment`.
+fn named(experiment: &str, spans: Vec<czid_core::Span>) -> Vec<Regime> {
+    spans
+        .into_iter()
+        .map(|s| Regime { experiment: experiment.into(), name: s.name.into(), from: s.from, to: s.to })
+        .collect()
+}
+
 fn split(s: &Synthetic) -> Vec<Regime> {
-    beam::split("beam", &s.displacement, &s.load, Some((&s.displacement, &s.debonded_length)))
+    named("beam", beam::split(&s.displacement, &s.load, Some((&s.displacement, &s.debonded_length))))
 }
 
 /// Where the model itself yields: the first recorded state at which the same beam with bars that
@@ -171,7 +180,7 @@ fn on_a_curve_with_real_cracking_the_knees_are_the_sections_cracking_and_yield_l
         let from = start_of(regs, name).unwrap().from;
         y[x.iter().position(|&v| v == from).unwrap()]
     };
-    let regs = beam::split("section", &x, &y, None);
+    let regs = named("section", beam::split(&x, &y, None));
     let names: Vec<&str> = regs.iter().map(|r| r.name.as_str()).collect();
     // No debonding in a perfectly bonded section: the curve rises to its last reading.
     assert_eq!(names, ["uncracked", "cracked", "yielded"], "{regs:?}");
@@ -185,7 +194,7 @@ fn on_a_curve_with_real_cracking_the_knees_are_the_sections_cracking_and_yield_l
     let noisy =
         synthesize(&section_record(&x, &y), READINGS, None, &Noise { load_sd: 0.005 * peak, length_sd: 0.0, seed: 4 })
             .unwrap();
-    let regs = beam::split("section", &noisy.displacement, &noisy.load, None);
+    let regs = named("section", beam::split(&noisy.displacement, &noisy.load, None));
     let read = |name: &str| {
         let from = start_of(&regs, name).unwrap().from;
         Curve::new(x.clone(), y.clone()).unwrap().at(from)
@@ -205,12 +214,13 @@ fn section_record(x: &[f64], y: &[f64]) -> Record {
 }
 
 #[test]
-fn the_regime_set_is_chosen_per_experiment_from_its_model() {
-    assert_eq!(RegimeSet::of_model("frp_beam"), RegimeSet::Beam);
-    assert_eq!(RegimeSet::of_model("dcb"), RegimeSet::Generic);
-    assert_eq!(RegimeSet::Beam.held_out(), "debonding");
-    assert_eq!(RegimeSet::Generic.held_out(), regimes::NAMES[3]);
+fn the_regime_rule_is_the_one_each_experiment_s_model_declares() {
     let beam = FrpBeam::paper().unwrap();
+    assert_eq!(beam.regimes().names(), BeamRegimes.names());
+    assert_eq!(beam.regimes().held_out(), "debonding");
+    let dcb = czid_models::dcb::Dcb::hartlen_dcb01();
+    assert_eq!(dcb.regimes().names(), regimes::NAMES);
+    assert_eq!(dcb.regimes().held_out(), regimes::NAMES[3]);
     let rec = record(&beam);
     let s = synthesize(&rec, 200, None, &Noise { load_sd: 0.0, length_sd: 0.0, seed: 1 }).unwrap();
     let e = experiment(&s);

@@ -77,7 +77,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<(), CzError> {
     let problem = LoadedProblem::read_with(&args.problem, &args.sets)?;
     let library = Library::builtin();
     // Unknown candidate names are reported before any work.
-    library.select(&args.candidates)?;
+    library.select(&problem.setup()?, &args.candidates)?;
     let withheld = args.withheld.iter().map(|p| LoadedProblem::read(p)).collect::<Result<Vec<_>, _>>()?;
     let start = args.from.as_ref().map(|p| read_start(p, &problem)).transpose()?;
     let dir = OutputDir::create(&args.out, args.force, false)?;

@@ -708,6 +708,14 @@ impl ForwardModel for FrpBeam {
         FrpBeam::validate(self)
     }
 
+    fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
+        super::beam_effects::BeamEffects::declarations()
+    }
+
+    fn regimes(&self) -> &'static dyn czid_core::RegimeRule {
+        &super::regimes::BeamRegimes
+    }
+
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
         self.run(law, false).map(|r| r.record)
     }

@@ -11,7 +11,7 @@
 //! neither would change its response.
 
 use czid_core::error::require_non_negative;
-use czid_core::{CzError, Result};
+use czid_core::{CzError, EffectDeclaration, EffectKind, EffectScope, Result, Sign, Typical};
 use serde::{Deserialize, Serialize};
 
 /// Optional physics of the plated beam. `BeamEffects::default()` is the base model.
@@ -38,7 +38,82 @@ pub struct BeamEffects {
     pub deflection_offset: f64,
 }
 
+/// A shared size effect of the beam (one value for every beam of a problem).
+const fn shared(
+    name: &'static str,
+    description: &'static str,
+    field: &'static str,
+    unit: &'static str,
+    range: [f64; 2],
+    typical: Typical,
+) -> EffectDeclaration {
+    EffectDeclaration {
+        name,
+        description,
+        field,
+        unit,
+        kind: EffectKind::Size { range, null: 0.0 },
+        scope: EffectScope::Shared,
+        typical: Some(typical),
+    }
+}
+
+/// The beam's switchable effects, in the order the diagnosis lists them.
+const DECLARATIONS: [EffectDeclaration; 5] = [
+    shared(
+        "adhesive_compliance",
+        "shear compliance of the adhesive layer in series with the bond law",
+        "effects.adhesive_shear_compliance",
+        "mm/MPa",
+        [0.0, 2e-3],
+        // Adhesive 1–2 mm thick of shear modulus 2–5 GPa: t_a/G_a = 2e-4–1e-3 mm/MPa.
+        Typical { magnitude: [2e-4, 1e-3], sign: Sign::Positive },
+    ),
+    shared(
+        "adhesive_normal_compliance",
+        "normal (peeling) compliance of the adhesive layer",
+        "effects.adhesive_normal_compliance",
+        "mm/MPa",
+        [0.0, 1e-3],
+        // The same layer in peeling, E_a = 5–12 GPa: t_a/E_a = 1e-4–4e-4 mm/MPa.
+        Typical { magnitude: [1e-4, 4e-4], sign: Sign::Positive },
+    ),
+    shared(
+        "shrinkage_strain",
+        "concrete shrinkage (or swelling) after bonding, prestressing the bond",
+        "effects.shrinkage_strain",
+        "-",
+        [-4e-4, 2e-4],
+        // Drying shrinkage of the concrete after the plate was bonded: 100–300 µε.
+        Typical { magnitude: [1e-4, 3e-4], sign: Sign::Negative },
+    ),
+    shared(
+        "steel_hardening",
+        "a different hardening modulus of the bars after yield",
+        "effects.steel_hardening_offset",
+        "MPa",
+        [-1500.0, 3000.0],
+        // Bars hardening at 0.25–0.75 % or 1.25–2.25 % of E_s instead of the assumed 1 %.
+        Typical { magnitude: [500.0, 1500.0], sign: Sign::Either },
+    ),
+    EffectDeclaration {
+        name: "deflection_offset",
+        description: "seating of the supports (a toe of the load–deflection curve)",
+        field: "effects.deflection_offset",
+        unit: "mm",
+        kind: EffectKind::Size { range: [0.0, 2.0], null: 0.0 },
+        scope: EffectScope::PerExperiment,
+        // Seating of the supports and load points: 0.3–1.5 mm.
+        typical: Some(Typical { magnitude: [0.3, 1.5], sign: Sign::Positive }),
+    },
+];
+
 impl BeamEffects {
+    /// The beam's switchable effects (what the diagnosis offers as candidates for a beam test).
+    pub fn declarations() -> Vec<EffectDeclaration> {
+        DECLARATIONS.to_vec()
+    }
+
     /// Checks every value, naming the field of `owner` that is invalid.
     pub fn validate(&self, owner: &str) -> Result<()> {
         require_non_negative(owner, "effects.adhesive_shear_compliance", self.adhesive_shear_compliance)?;

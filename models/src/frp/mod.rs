@@ -9,7 +9,8 @@
 //!   `frp_pull`), any bond–slip law;
 //! * [`beam`]: the plated beam in four-point bending on the engine (forward model `frp_beam`):
 //!   fibre-section RC beam, plate on a cohesive interface, IC debonding; [`beam_effects`] its
-//!   switchable physical effects;
+//!   switchable physical effects, [`regimes`] the regimes of its tests (uncracked, cracked,
+//!   yielded, debonding);
 //! * [`spec`]: the beam's configuration with our documented choices for what the paper leaves
 //!   out ([`FrpBeamSpec::paper`]).
 //!
@@ -20,6 +21,7 @@ pub mod beam;
 pub mod beam_effects;
 pub mod bond;
 pub mod pull;
+pub mod regimes;
 pub mod section;
 pub mod spec;
 

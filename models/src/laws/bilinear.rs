@@ -206,6 +206,16 @@ impl CohesiveLaw for Bilinear {
         [self.strength_n, self.strength_t]
     }
 
+    fn with_bridging_tail(&self, strength: f64, opening: f64) -> Option<Result<Box<dyn CohesiveLaw>>> {
+        Some(if strength == 0.0 {
+            // The null: the law itself, not a superposition with an empty part.
+            Ok(Box::new(self.clone()))
+        } else {
+            crate::laws::Bridging::bilinear_with_tail(self, strength, opening)
+                .map(|b| Box::new(b) as Box<dyn CohesiveLaw>)
+        })
+    }
+
     fn parameters(&self) -> Vec<ParameterInfo> {
         vec![
             ParameterInfo {

@@ -64,6 +64,33 @@ impl Bridging {
         Bridging::new(part(penalty * (1.0 - share), matrix)?, part(penalty * share, bridging)?)
     }
 
+    /// A bilinear law with a long, weak bilinear tail for fibre bridging: the tail has strength
+    /// `strength` (MPa; 0 is the law itself) and final opening `opening` (mm); it peaks at the
+    /// matrix's onset opening (its penalty and shear strength scale with `strength / σ_n`), so its
+    /// shape is fixed by `opening` and its size by `strength`; its toughness is `strength ·
+    /// opening / 2` in mode I, and in mode II in the matrix's ratio `G_IIc / G_Ic`.
+    pub fn bilinear_with_tail(matrix: &Bilinear, strength: f64, opening: f64) -> Result<Self> {
+        if !(strength > 0.0 && opening > 0.0) {
+            return Err(CzError::invalid(
+                "law bridging",
+                "bridging",
+                strength.min(opening),
+                "tail strength and opening must be positive",
+            ));
+        }
+        let ratio = strength / matrix.strength_n;
+        let g_b = 0.5 * strength * opening;
+        let tail = Bilinear {
+            penalty: matrix.penalty * ratio,
+            strength_n: strength,
+            strength_t: matrix.strength_t * ratio,
+            g_ic: g_b,
+            g_iic: matrix.g_iic * g_b / matrix.g_ic,
+            ..matrix.clone()
+        };
+        Bridging::new(matrix.clone(), tail)
+    }
+
     fn weights(&self) -> (f64, f64) {
         let total = self.matrix.penalty + self.bridging.penalty;
         (self.matrix.penalty / total, self.bridging.penalty / total)
@@ -130,6 +157,18 @@ impl CohesiveLaw for Bridging {
             }
         }
         peak
+    }
+
+    /// Where the matrix has failed: the combined damage there is `D* = 1 − t_b(δ_c) / ((K_m +
+    /// K_b) δ_c)`, `δ_c` the matrix's final opening and `t_b` the tail's traction (mode I; the
+    /// damage grows monotonically with the opening, so the front at `D*` is the matrix's). Levels
+    /// from `1 − 10⁻⁶` on would mean complete failure of both parts to the engine; just below it
+    /// the front lies within a hair of the matrix's failure opening.
+    fn visible_front_damage(&self) -> Option<f64> {
+        let dc = 2.0 * self.matrix.g_ic / self.matrix.strength_n;
+        let tb = pure_mode_traction(&self.bridging, 0, dc);
+        let k = self.matrix.penalty + self.bridging.penalty;
+        Some((1.0 - tb / (k * dc)).min(1.0 - 1.0001e-6))
     }
 
     fn parameters(&self) -> Vec<ParameterInfo> {

@@ -11,7 +11,7 @@ mod family;
 pub use family::{Family, TestDraw};
 
 use crate::data::Experiment;
-use crate::diagnose::candidate::Library;
+use crate::diagnose::candidate::{CandidateEffect, Library};
 use crate::diagnose::run::{diagnose_subject, Options, Subject};
 use crate::diagnose::stats::chi2_survival;
 use crate::output::OutputDir;
@@ -116,11 +116,20 @@ pub struct BenchReport {
     pub wall_seconds: f64,
 }
 
-fn case(index: usize, planted: &str, seed: u64, family: Family, library: &Library) -> CaseResult {
+/// Runs one case: `planted` names the effect (`effect`, the candidate that plants it; `None` for a
+/// null case).
+fn case(
+    index: usize,
+    planted: &str,
+    effect: Option<&dyn CandidateEffect>,
+    seed: u64,
+    family: Family,
+    library: &Library,
+) -> CaseResult {
     let clock = std::time::Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
     let TestDraw { truth, noise, readings, end } = family.draw(&mut rng);
-    let mut size = if planted == NONE { Vec::new() } else { family.plant(planted, &mut rng).unwrap_or_default() };
+    let mut size = effect.and_then(|c| c.plant(&mut rng)).unwrap_or_default();
     let jitter: Vec<f64> = (0..3).map(|_| rng.random_range(-0.05..0.05)).collect();
     let noise_seed: u64 = rng.random();
     let mut out = CaseResult {
@@ -149,18 +158,16 @@ fn case(index: usize, planted: &str, seed: u64, family: Family, library: &Librar
         // A planted model that stops early is drawn again (a few times), and counted.
         let mut attempt = 0;
         let record = loop {
-            let true_setup = if planted == NONE {
-                base.duplicate()?
-            } else {
-                let c = library.select(&[planted.to_string()])?[0];
-                c.apply(&base, &size)?
+            let true_setup = match effect {
+                None => base.duplicate()?,
+                Some(c) => c.apply(&base, &size)?,
             };
             match true_setup.models[family.name()].simulate(true_setup.law.as_ref()) {
                 Ok(r) => break r,
                 Err(f) if attempt < 5 && planted != NONE => {
                     attempt += 1;
                     out.redraws = attempt;
-                    size = family.plant(planted, &mut rng).unwrap_or_default();
+                    size = effect.and_then(|c| c.plant(&mut rng)).unwrap_or_default();
                     out.size = size.clone();
                     let _ = f;
                 }
@@ -262,17 +269,24 @@ pub fn run(
     let family = opts.family;
     // Every candidate that applies to the family's model and that it knows how to plant.
     let sample = family.base_setup(&family.draw(&mut ChaCha8Rng::seed_from_u64(0)).truth, None)?;
-    let known = |name: &str| family.plant(name, &mut ChaCha8Rng::seed_from_u64(0)).is_some();
+    let offered = library.names(&sample);
+    if let Some(unknown) = opts.effects.iter().find(|e| !offered.contains(e)) {
+        return Err(CzError::config(
+            "--effects",
+            format!(
+                "`{unknown}` cannot be planted in the {} benchmark; its model's candidates: {}",
+                family.name(),
+                offered.join(", ")
+            ),
+        ));
+    }
+    let candidates = library.select(&sample, &opts.effects)?;
+    let known = |c: &dyn CandidateEffect| c.plant(&mut ChaCha8Rng::seed_from_u64(0)).is_some();
     let effects: Vec<String> = if opts.effects.is_empty() {
-        library
-            .all()
-            .into_iter()
-            .filter(|c| c.applies(&sample) && known(c.name()))
-            .map(|c| c.name().to_string())
-            .collect()
+        candidates.iter().filter(|c| c.applies(&sample) && known(c.as_ref())).map(|c| c.name().to_string()).collect()
     } else {
-        for c in library.select(&opts.effects)? {
-            if !c.applies(&sample) || !known(c.name()) {
+        for c in &candidates {
+            if !c.applies(&sample) || !known(c.as_ref()) {
                 return Err(CzError::config(
                     "--effects",
                     format!("`{}` cannot be planted in the {} benchmark", c.name(), family.name()),
@@ -299,7 +313,8 @@ pub fn run(
                 .and_then(|text| serde_json::from_str::<CaseResult>(&text).ok())
                 .filter(|c| c.error.is_none());
             let r = kept.unwrap_or_else(|| {
-                let r = case(i, p, opts.seed, family, &library);
+                let effect = candidates.iter().find(|c| c.name() == p).map(|c| c.as_ref());
+                let r = case(i, p, effect, opts.seed, family, &library);
                 if let (Some(s), Ok(json)) = (store, serde_json::to_string_pretty(&r)) {
                     // Losing a kept case only costs its rerun.
                     let _ = s.dir.write(&file, &json);

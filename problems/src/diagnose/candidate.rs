@@ -6,14 +6,16 @@
 //! the diagnosis measures the effect as a departure from the fitted base model, and the tests
 //! check it for every bundled candidate.
 //!
-//! Three generic kinds cover the bundled library, so that a new one is a table entry:
-//! [`ModelField`] (a number in the models' configuration, e.g. `effects.machine_compliance`),
-//! [`ModelFlag`] (a switch, e.g. `effects.large_rotation`) and [`BridgingTail`] (the law swapped
-//! for a superposed law with a fibre-bridging tail of zero amplitude at the null).
+//! Most candidates are not written here at all: a forward model declares its switchable effects
+//! ([`czid_core::ForwardModel::effects`]) and the library turns each declaration into a
+//! [`Declared`] candidate for the setups whose models declare it. Candidates that change the law
+//! rather than a model ([`BridgingTail`]) and a user's own are registered with [`Library::add`].
 
 use crate::identification::Setup;
-use czid_core::{CzError, Parameter, Result};
-use serde_json::{json, Value};
+use czid_core::{CzError, EffectDeclaration, EffectScope, Parameter, ParameterSpace, Result, Sign};
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+use std::sync::Arc;
 
 /// A parameter of a candidate effect.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,183 +50,123 @@ pub trait CandidateEffect: Send + Sync {
     fn transferable(&self) -> bool {
         true
     }
+    /// Values of a size seen in real tests, drawn from `rng`, to plant the effect in a synthetic
+    /// test (`None`: not planted).
+    fn plant(&self, _rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
+        None
+    }
 }
 
-fn to_tree(setup: &Setup) -> Result<Value> {
-    serde_json::to_value(setup).map_err(|e| CzError::config("setup", e.to_string()))
-}
-
-fn from_tree(tree: Value, owner: &str) -> Result<Setup> {
-    let s: Setup =
-        serde_json::from_value(tree).map_err(|e| CzError::config(format!("candidate `{owner}`"), e.to_string()))?;
-    s.validate().map_err(|e| CzError::config(format!("candidate `{owner}`"), e.to_string()))?;
-    Ok(s)
-}
-
-fn walk<'a>(v: &'a mut Value, path: &str) -> Option<&'a mut Value> {
-    path.split('.').try_fold(v, |node, key| node.get_mut(key))
-}
-
-fn number(v: f64, owner: &str) -> Result<Value> {
-    serde_json::Number::from_f64(v)
-        .map(Value::Number)
-        .ok_or_else(|| CzError::invalid(format!("candidate `{owner}`"), "value", v, "must be finite"))
-}
-
-/// Experiments whose model type is one of `models`, in setup order.
-fn matching(setup: &Setup, models: &[String]) -> Vec<String> {
-    setup.models.iter().filter(|(_, m)| models.iter().any(|t| t == m.name())).map(|(k, _)| k.clone()).collect()
-}
-
-/// A number in the forward models' configuration whose null value is the base model, e.g.
-/// `effects.machine_compliance` of a DCB.
+/// A candidate built from an effect that forward models declare: it applies to the experiments
+/// of a setup whose models declare an effect of that name, with one value per experiment or one
+/// shared by all of them as the declaration says.
 #[derive(Clone, Debug)]
-pub struct ModelField {
-    /// Candidate name.
-    pub name: String,
-    /// The physics, in one sentence.
-    pub description: String,
-    /// Model types (`ForwardModel::name`) it applies to.
-    pub models: Vec<String>,
-    /// Dotted path inside a model's configuration.
-    pub field: String,
-    /// Unit of the value.
-    pub unit: String,
-    /// Null value (the base model).
-    pub null: f64,
-    /// Realistic range.
-    pub lower: f64,
-    /// Realistic range.
-    pub upper: f64,
-    /// One value per experiment (specimen-specific) rather than one for all.
-    pub per_experiment: bool,
+pub struct Declared {
+    /// The declaration (of the first model that declares the name).
+    pub declaration: EffectDeclaration,
+    /// Model types (`ForwardModel::name`) the effect is tried on regardless of what they declare
+    /// (a user's trial of a field of a bundled model); `None`: the models that declare it.
+    pub models: Option<Vec<String>>,
 }
 
-impl ModelField {
-    /// A field shared by every matching experiment (same machine, same material).
-    pub fn shared(name: &str, description: &str, models: &[&str], field: &str, unit: &str, range: [f64; 2]) -> Self {
-        ModelField {
-            name: name.into(),
-            description: description.into(),
-            models: models.iter().map(|s| s.to_string()).collect(),
-            field: field.into(),
-            unit: unit.into(),
-            null: 0.0,
-            lower: range[0],
-            upper: range[1],
-            per_experiment: false,
-        }
+impl Declared {
+    /// A candidate for the models that declare `declaration`'s name.
+    pub fn new(declaration: EffectDeclaration) -> Self {
+        Declared { declaration, models: None }
     }
 
-    /// One value per experiment (a property of each specimen).
-    pub fn per_experiment(mut self) -> Self {
-        self.per_experiment = true;
-        self
+    /// A candidate for a field of the given model types that they do not declare themselves,
+    /// e.g. `Declared::on_models(declaration, &["dcb"])` to try an arm modulus error.
+    pub fn on_models(declaration: EffectDeclaration, models: &[&str]) -> Self {
+        Declared { declaration, models: Some(models.iter().map(|m| m.to_string()).collect()) }
+    }
+
+    /// Experiments the effect applies to, in setup order.
+    fn experiments(&self, setup: &Setup) -> Vec<String> {
+        let name = self.declaration.name;
+        let takes = |m: &dyn czid_core::ForwardModel| match &self.models {
+            Some(types) => types.iter().any(|t| t == m.name()),
+            None => m.effects().iter().any(|d| d.name == name),
+        };
+        setup.models.iter().filter(|(_, m)| takes(m.as_ref())).map(|(k, _)| k.clone()).collect()
+    }
+
+    /// The effect's value in each of `names`, as a parameter space over their paths.
+    fn slots(&self, names: &[String]) -> Result<ParameterSpace> {
+        let [lo, hi] = self.declaration.range();
+        let unit = self.declaration.unit;
+        ParameterSpace::new(
+            names
+                .iter()
+                .map(|n| Parameter::new(&format!("models.{n}.{}", self.declaration.field), unit, lo, hi))
+                .collect(),
+        )
+    }
+
+    fn per_experiment(&self) -> bool {
+        self.declaration.scope == EffectScope::PerExperiment
     }
 }
 
-impl CandidateEffect for ModelField {
+impl CandidateEffect for Declared {
     fn name(&self) -> &str {
-        &self.name
+        self.declaration.name
     }
     fn describe(&self) -> String {
-        self.description.clone()
+        self.declaration.description.into()
     }
     fn applies(&self, setup: &Setup) -> bool {
-        let names = matching(setup, &self.models);
-        let Ok(mut tree) = to_tree(setup) else { return false };
-        !names.is_empty()
-            && names.iter().all(|n| {
-                walk(&mut tree, &format!("models.{n}.{}", self.field)).and_then(|v| v.as_f64()) == Some(self.null)
-            })
+        let names = self.experiments(setup);
+        let null = self.declaration.null();
+        !names.is_empty() && self.slots(&names).and_then(|s| s.read(setup)).is_ok_and(|v| v.iter().all(|&x| x == null))
     }
     fn parameters(&self, setup: &Setup) -> Result<Vec<EffectParameter>> {
-        let names = matching(setup, &self.models);
-        let labels: Vec<String> = if self.per_experiment {
-            names.iter().map(|n| format!("models.{n}.{}", self.field)).collect()
+        let d = &self.declaration;
+        let [lo, hi] = d.range();
+        let labels: Vec<String> = if self.per_experiment() && !d.is_switch() {
+            self.experiments(setup).iter().map(|n| format!("models.{n}.{}", d.field)).collect()
         } else {
-            vec![format!("models.*.{}", self.field)]
+            vec![format!("models.*.{}", d.field)]
         };
-        labels
+        Ok(labels
             .into_iter()
-            .map(|path| {
-                Ok(EffectParameter {
-                    parameter: Parameter::new(&path, &self.unit, self.lower, self.upper),
-                    null: self.null,
-                })
-            })
-            .collect()
+            .map(|path| EffectParameter { parameter: Parameter::new(&path, d.unit, lo, hi), null: d.null() })
+            .collect())
     }
     fn apply(&self, setup: &Setup, values: &[f64]) -> Result<Setup> {
-        let names = matching(setup, &self.models);
-        let expected = if self.per_experiment { names.len() } else { 1 };
+        let owner = || format!("candidate `{}`", self.declaration.name);
+        let names = self.experiments(setup);
+        let per = self.per_experiment() && !self.declaration.is_switch();
+        let expected = if per { names.len() } else { 1 };
         if values.len() != expected {
-            return Err(CzError::config(
-                format!("candidate `{}`", self.name),
-                format!("{} values for {expected} parameters", values.len()),
-            ));
+            return Err(CzError::config(owner(), format!("{} values for {expected} parameters", values.len())));
         }
-        let mut tree = to_tree(setup)?;
-        for (i, n) in names.iter().enumerate() {
-            let v = if self.per_experiment { values[i] } else { values[0] };
-            let slot = walk(&mut tree, &format!("models.{n}.{}", self.field)).ok_or_else(|| {
-                CzError::config(format!("candidate `{}`", self.name), format!("model `{n}` has no `{}`", self.field))
-            })?;
-            *slot = number(v, &self.name)?;
-        }
-        from_tree(tree, &self.name)
-    }
-    fn transferable(&self) -> bool {
-        !self.per_experiment
-    }
-}
-
-/// A switch in the forward models' configuration, off in the base model (e.g.
-/// `effects.large_rotation`).
-#[derive(Clone, Debug)]
-pub struct ModelFlag {
-    /// Candidate name.
-    pub name: String,
-    /// The physics, in one sentence.
-    pub description: String,
-    /// Model types it applies to.
-    pub models: Vec<String>,
-    /// Dotted path of the boolean inside a model's configuration.
-    pub field: String,
-}
-
-impl CandidateEffect for ModelFlag {
-    fn name(&self) -> &str {
-        &self.name
-    }
-    fn describe(&self) -> String {
-        self.description.clone()
-    }
-    fn applies(&self, setup: &Setup) -> bool {
-        let names = matching(setup, &self.models);
-        let Ok(mut tree) = to_tree(setup) else { return false };
-        !names.is_empty()
-            && names.iter().all(|n| {
-                walk(&mut tree, &format!("models.{n}.{}", self.field)).and_then(|v| v.as_bool()) == Some(false)
-            })
-    }
-    fn parameters(&self, _setup: &Setup) -> Result<Vec<EffectParameter>> {
-        let path = format!("models.*.{}", self.field);
-        Ok(vec![EffectParameter { parameter: Parameter::new(&path, "on/off", 0.0, 1.0), null: 0.0 }])
-    }
-    fn apply(&self, setup: &Setup, values: &[f64]) -> Result<Setup> {
-        let on = values.first().is_some_and(|v| *v >= 0.5);
-        let mut tree = to_tree(setup)?;
-        for n in matching(setup, &self.models) {
-            let slot = walk(&mut tree, &format!("models.{n}.{}", self.field)).ok_or_else(|| {
-                CzError::config(format!("candidate `{}`", self.name), format!("model `{n}` has no `{}`", self.field))
-            })?;
-            *slot = Value::Bool(on);
-        }
-        from_tree(tree, &self.name)
+        let each: Vec<f64> = (0..names.len()).map(|i| if per { values[i] } else { values[0] }).collect();
+        let extended = self.slots(&names)?.apply(setup, &each).map_err(|e| CzError::config(owner(), e.to_string()))?;
+        extended.validate().map_err(|e| CzError::config(owner(), e.to_string()))?;
+        Ok(extended)
     }
     fn discrete(&self) -> bool {
-        true
+        self.declaration.is_switch()
+    }
+    fn transferable(&self) -> bool {
+        self.declaration.scope == EffectScope::Shared
+    }
+    fn plant(&self, rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
+        if self.declaration.is_switch() {
+            return Some(vec![1.0]);
+        }
+        let t = self.declaration.typical?;
+        let [lo, hi] = t.magnitude;
+        // The sign is drawn before the magnitude (a benchmark's cases are reproducible draw by draw).
+        Some(vec![match t.sign {
+            Sign::Positive => rng.random_range(lo..hi),
+            Sign::Negative => -rng.random_range(lo..hi),
+            Sign::Either => {
+                let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
+                sign * rng.random_range(lo..hi)
+            }
+        }])
     }
 }
 
@@ -258,7 +200,7 @@ impl CandidateEffect for BridgingTail {
         "fibre bridging behind the crack front (a rising R-curve): a long, weak cohesive tail added to the law".into()
     }
     fn applies(&self, setup: &Setup) -> bool {
-        to_tree(setup).ok().and_then(|t| t["law"]["type"].as_str().map(|s| s == "bilinear")).unwrap_or(false)
+        setup.law.with_bridging_tail(0.0, self.opening).is_some()
     }
     fn parameters(&self, _setup: &Setup) -> Result<Vec<EffectParameter>> {
         Ok(vec![
@@ -278,187 +220,53 @@ impl CandidateEffect for BridgingTail {
         ])
     }
     fn apply(&self, setup: &Setup, values: &[f64]) -> Result<Setup> {
-        let owner = self.name();
+        let owner = || format!("candidate `{}`", self.name());
         let (&strength, &opening) = match values {
             [s, o] => (s, o),
-            _ => return Err(CzError::config(format!("candidate `{owner}`"), "needs 2 values (strength, opening)")),
+            _ => return Err(CzError::config(owner(), "needs 2 values (strength, opening)")),
         };
-        if strength == 0.0 {
-            // The null: the base law itself, not a superposition with an empty part.
-            return setup.duplicate();
-        }
-        if !(strength > 0.0 && opening > 0.0) {
-            return Err(CzError::invalid(
-                format!("candidate `{owner}`"),
-                "law.bridging",
-                strength.min(opening),
-                "tail strength and opening must be positive",
-            ));
-        }
-        let mut tree = to_tree(setup)?;
-        let mut matrix = tree["law"].clone();
-        let m = matrix
-            .as_object_mut()
-            .ok_or_else(|| CzError::config(format!("candidate `{owner}`"), "law is not a table"))?;
-        m.remove("type");
-        let get = |k: &str| m.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
-        let (k, sn, st, gi, gii) = (get("penalty"), get("strength_n"), get("strength_t"), get("g_ic"), get("g_iic"));
-        let ratio = strength / sn;
-        let g_b = 0.5 * strength * opening;
-        let mut tail = Value::Object(m.clone());
-        tail["penalty"] = number(k * ratio, owner)?;
-        tail["strength_n"] = number(strength, owner)?;
-        tail["strength_t"] = number(st * ratio, owner)?;
-        tail["g_ic"] = number(g_b, owner)?;
-        tail["g_iic"] = number(gii * g_b / gi, owner)?;
-        tree["law"] = json!({ "type": "bridging", "matrix": matrix, "bridging": tail });
-        // A measured crack length is the visible (matrix) crack tip, with fibres still bridging
-        // behind it. The superposed law reports complete failure only where the tail has failed
-        // too, so the DCB's debonded front is moved to where the matrix fails: its combined
-        // damage there is D* = 1 − t_b(δ_c) / ((K_m + K_b) δ_c), δ_c the matrix's final opening
-        // (the damage grows monotonically with the opening, so the front at D* is the matrix's).
-        let dc = 2.0 * gi / sn;
-        let d0 = sn / k;
-        let tb = if dc < opening { strength * (opening - dc) / (opening - d0) } else { 0.0 };
-        // Levels from 1 − 10⁻⁶ on would mean complete failure of both parts to the engine; just
-        // below it the front lies within a hair of the matrix's failure opening.
-        let level = (1.0 - tb / (k * (1.0 + ratio) * dc)).min(1.0 - 1.0001e-6);
-        let names = matching(setup, &["dcb".to_string()]);
-        for n in names {
-            if let Some(t) = walk(&mut tree, &format!("models.{n}.control.damage_threshold")) {
-                // Only the default (complete failure) is replaced; a level chosen by the user stays.
-                if t.as_f64().is_some_and(|v| v >= 1.0 - 1.0001e-6) {
-                    *t = number(level, owner)?;
-                }
-            }
-        }
-        from_tree(tree, owner)
+        let law = setup
+            .law
+            .with_bridging_tail(strength, opening)
+            .ok_or_else(|| CzError::config(owner(), "the law has no fibre-bridging extension"))?
+            .map_err(|e| CzError::config(owner(), e.to_string()))?;
+        let mut extended = setup.duplicate()?;
+        extended.law = law;
+        extended.validate().map_err(|e| CzError::config(owner(), e.to_string()))?;
+        Ok(extended)
+    }
+    fn plant(&self, rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
+        // Tails of 0.3–1.5 MPa over 0.5–2 mm openings: 0.1–1.5 N/mm of extra toughness.
+        Some(vec![rng.random_range(0.3..1.5), rng.random_range(0.5..2.0)])
     }
 }
 
-/// A table entry of a [`ModelField`] candidate: name, description, field, unit, range, per
-/// experiment.
-type Entry = (&'static str, &'static str, &'static str, &'static str, [f64; 2], bool);
+/// One entry of a [`Library`].
+#[derive(Clone)]
+enum Entry {
+    /// A registered candidate.
+    Candidate(Arc<dyn CandidateEffect>),
+    /// Every effect the setup's forward models declare.
+    Declared,
+}
 
-/// The candidates a diagnosis draws from: the bundled ones plus any registered by the user.
+/// The candidates a diagnosis draws from: the effects the forward models declare, the law
+/// extensions (fibre bridging) and any candidate registered by the user.
+#[derive(Clone)]
 pub struct Library {
-    candidates: Vec<Box<dyn CandidateEffect>>,
+    entries: Vec<Entry>,
 }
 
 impl Library {
-    /// An empty library.
+    /// An empty library (not even the declared effects).
     pub fn empty() -> Self {
-        Library { candidates: Vec::new() }
+        Library { entries: Vec::new() }
     }
 
-    /// The bundled candidates: for the DCB and ENF (ranges realistic for coupon-size specimens,
-    /// arms of 1–5 mm, cracks of 20–100 mm) and for the FRP-strengthened beam (`frp_beam`,
-    /// laboratory beams with bonded plates). Each applies only to its models.
+    /// The bundled library: fibre bridging (for laws that have a bridging extension), then every
+    /// effect the setup's forward models declare.
     pub fn builtin() -> Self {
-        let beams = ["dcb", "enf"];
-        let mut lib = Library::empty();
-        lib.add(BridgingTail::default());
-        lib.add(ModelFlag {
-            name: "large_rotation".into(),
-            description: "large rotations of the arms (geometric non-linearity at large openings)".into(),
-            models: vec!["dcb".into()],
-            field: "effects.large_rotation".into(),
-        });
-        lib.add(ModelField::shared(
-            "root_compliance",
-            "root rotation at the crack front: through-thickness compliance of the arms (elastic foundation)",
-            &beams,
-            "effects.root_compliance",
-            "mm/MPa",
-            [0.0, 1e-3],
-        ));
-        lib.add(ModelField::shared(
-            "machine_compliance",
-            "compliance of the machine and load train in series with the specimen",
-            &beams,
-            "effects.machine_compliance",
-            "mm/N",
-            [0.0, 1e-2],
-        ));
-        lib.add(
-            ModelField::shared(
-                "crack_length_offset",
-                "initial crack length different from the nominal one (blunt insert, misread pre-crack)",
-                &beams,
-                "effects.crack_length_offset",
-                "mm",
-                [-5.0, 5.0],
-            )
-            .per_experiment(),
-        );
-        lib.add(
-            ModelField::shared(
-                "displacement_offset",
-                "displacement zero offset: seating of the grips or hinges (a toe)",
-                &beams,
-                "effects.displacement_offset",
-                "mm",
-                [-1.0, 1.0],
-            )
-            .per_experiment(),
-        );
-        lib.add(ModelField::shared(
-            "shear_compliance",
-            "more shear deformation of the arms than the nominal G13 gives",
-            &beams,
-            "effects.shear_compliance",
-            "1/MPa",
-            [0.0, 1e-3],
-        ));
-        // The FRP-strengthened beam: one table entry per switchable effect of the model.
-        let frp = ["frp_beam"];
-        let entries: [Entry; 5] = [
-            (
-                "adhesive_compliance",
-                "shear compliance of the adhesive layer in series with the bond law",
-                "effects.adhesive_shear_compliance",
-                "mm/MPa",
-                [0.0, 2e-3],
-                false,
-            ),
-            (
-                "adhesive_normal_compliance",
-                "normal (peeling) compliance of the adhesive layer",
-                "effects.adhesive_normal_compliance",
-                "mm/MPa",
-                [0.0, 1e-3],
-                false,
-            ),
-            (
-                "shrinkage_strain",
-                "concrete shrinkage (or swelling) after bonding, prestressing the bond",
-                "effects.shrinkage_strain",
-                "-",
-                [-4e-4, 2e-4],
-                false,
-            ),
-            (
-                "steel_hardening",
-                "a different hardening modulus of the bars after yield",
-                "effects.steel_hardening_offset",
-                "MPa",
-                [-1500.0, 3000.0],
-                false,
-            ),
-            (
-                "deflection_offset",
-                "seating of the supports (a toe of the load–deflection curve)",
-                "effects.deflection_offset",
-                "mm",
-                [0.0, 2.0],
-                true,
-            ),
-        ];
-        for (name, description, field, unit, range, per_experiment) in entries {
-            let c = ModelField::shared(name, description, &frp, field, unit, range);
-            lib.add(if per_experiment { c.per_experiment() } else { c });
-        }
-        lib
+        Library { entries: vec![Entry::Candidate(Arc::new(BridgingTail::default())), Entry::Declared] }
     }
 
     /// Registers a candidate (a later one with the same name replaces the earlier).
@@ -468,34 +276,69 @@ impl Library {
 
     /// Registers a boxed candidate.
     pub fn add_boxed(&mut self, candidate: Box<dyn CandidateEffect>) -> &mut Self {
-        self.candidates.retain(|c| c.name() != candidate.name());
-        self.candidates.push(candidate);
+        let candidate: Arc<dyn CandidateEffect> = Arc::from(candidate);
+        self.entries.retain(|e| !matches!(e, Entry::Candidate(c) if c.name() == candidate.name()));
+        self.entries.push(Entry::Candidate(candidate));
         self
     }
 
-    /// Names, in registration order.
-    pub fn names(&self) -> Vec<&str> {
-        self.candidates.iter().map(|c| c.name()).collect()
+    /// Adds every effect the setup's forward models declare (once, where [`Library::builtin`] has
+    /// them), e.g. after starting from [`Library::empty`].
+    pub fn with_declared(&mut self) -> &mut Self {
+        if !self.entries.iter().any(|e| matches!(e, Entry::Declared)) {
+            self.entries.push(Entry::Declared);
+        }
+        self
     }
 
-    /// All candidates.
-    pub fn all(&self) -> Vec<&dyn CandidateEffect> {
-        self.candidates.iter().map(|c| c.as_ref()).collect()
+    /// Every candidate for `setup`, in library order: registered candidates, and where the
+    /// library holds the declared effects, one candidate per effect name the setup's models
+    /// declare (a registered candidate of the same name takes its place).
+    pub fn all(&self, setup: &Setup) -> Vec<Arc<dyn CandidateEffect>> {
+        let registered: Vec<&str> = self
+            .entries
+            .iter()
+            .filter_map(|e| match e {
+                Entry::Candidate(c) => Some(c.name()),
+                Entry::Declared => None,
+            })
+            .collect();
+        let mut out: Vec<Arc<dyn CandidateEffect>> = Vec::new();
+        for e in &self.entries {
+            match e {
+                Entry::Candidate(c) => out.push(c.clone()),
+                Entry::Declared => {
+                    for d in setup.models.values().flat_map(|m| m.effects()) {
+                        if !registered.contains(&d.name) && !out.iter().any(|c| c.name() == d.name) {
+                            out.push(Arc::new(Declared::new(d)));
+                        }
+                    }
+                }
+            }
+        }
+        out
     }
 
-    /// The named candidates (all when `names` is empty); an unknown name is an error listing the
-    /// known ones.
-    pub fn select(&self, names: &[String]) -> Result<Vec<&dyn CandidateEffect>> {
+    /// Names of the candidates for `setup`, in library order.
+    pub fn names(&self, setup: &Setup) -> Vec<String> {
+        self.all(setup).iter().map(|c| c.name().to_string()).collect()
+    }
+
+    /// The named candidates for `setup` (all when `names` is empty); an unknown name is an error
+    /// listing the known ones.
+    pub fn select(&self, setup: &Setup, names: &[String]) -> Result<Vec<Arc<dyn CandidateEffect>>> {
+        let all = self.all(setup);
         if names.is_empty() {
-            return Ok(self.all());
+            return Ok(all);
         }
         names
             .iter()
             .map(|n| {
-                self.candidates.iter().find(|c| c.name() == n).map(|c| c.as_ref()).ok_or_else(|| {
+                all.iter().find(|c| c.name() == n).cloned().ok_or_else(|| {
+                    let known: Vec<&str> = all.iter().map(|c| c.name()).collect();
                     CzError::config(
                         "--candidates",
-                        format!("unknown candidate `{n}`; known candidates: {}", self.names().join(", ")),
+                        format!("unknown candidate `{n}`; candidates for this problem: {}", known.join(", ")),
                     )
                 })
             })

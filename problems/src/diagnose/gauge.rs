@@ -3,8 +3,8 @@
 //! score statistics of the candidate effects can be compared with their χ² thresholds.
 
 use crate::data::Experiment;
-use crate::diagnose::noise;
 use crate::identification::{Setup, Term};
+use czid_core::noise;
 use czid_core::{columns, CzError, Record, Result};
 use rayon::prelude::*;
 use serde::Serialize;

@@ -2,7 +2,8 @@
 //! most likely causes it, and how far the misfit shrinks once that effect is added, checked on
 //! data withheld from the fit.
 //!
-//! * [`gauge`]: the misfit in units of the measurement noise ([`noise`]: estimated from the data).
+//! * [`gauge`]: the misfit in units of the measurement noise (estimated from the data by
+//!   [`czid_core::noise`]).
 //! * [`regimes`]: the test split into regimes from its load curve; misfit and sign per regime.
 //! * [`candidate`]: the [`CandidateEffect`] plug-in trait and the bundled [`Library`].
 //! * [`score`]: score statistics at the base fit, confounding, absorbing parameter.
@@ -14,13 +15,12 @@ pub mod bench;
 pub mod candidate;
 pub mod gauge;
 pub mod lsq;
-pub mod noise;
 pub mod regimes;
 pub mod report;
 pub mod run;
 pub mod score;
 pub mod stats;
 
-pub use candidate::{BridgingTail, CandidateEffect, EffectParameter, Library, ModelField, ModelFlag};
+pub use candidate::{BridgingTail, CandidateEffect, Declared, EffectParameter, Library};
 pub use gauge::{Gauge, NoiseLevels};
 pub use run::{diagnose, Diagnosis, Options};

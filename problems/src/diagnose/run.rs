@@ -41,7 +41,7 @@ pub struct Options {
     /// Other tests predicted with the calibrated parameters (transfer), e.g. other specimens.
     pub withheld: Vec<LoadedProblem>,
     /// Also check transfer to the held-out last regime of each curve (the late stage; a beam's
-    /// debonding, [`regimes::RegimeSet::held_out`]).
+    /// debonding, [`czid_core::RegimeRule::held_out`]).
     pub holdout: bool,
     /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
     pub always_refit: Vec<String>,
@@ -366,8 +366,8 @@ pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> R
             p(m)
         }
     };
-    library.select(&opts.candidates)?;
     let id = problem.identification()?;
+    library.select(id.setup(), &opts.candidates)?;
     let space = id.space().clone();
     let p = space.dim();
     let clock = Instant::now();
@@ -417,9 +417,9 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
             p(m)
         }
     };
-    let chosen = library.select(&opts.candidates)?;
     let space = subject.space.clone();
     let base = subject.setup.duplicate()?;
+    let chosen = library.select(&base, &opts.candidates)?;
     let gauge = Gauge::new(&subject.experiments, subject.use_length, opts.noise)?;
     let n = gauge.len();
     let p = space.dim();
@@ -465,7 +465,8 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     // 4. Which.
     let mut skipped = Vec::new();
     let applicable: Vec<&dyn CandidateEffect> = chosen
-        .into_iter()
+        .iter()
+        .map(|c| c.as_ref())
         .filter(|c| {
             let ok = c.applies(&fitted);
             if !ok {
@@ -522,19 +523,19 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     let base_regime_chi2 = regimes::rss_by_regime(&gauge, &regs, &misfit.r);
     // The held-out part of each curve: its family's held-out regime when that is its last regime
     // (the late stage; a beam's debonding), else the last quarter of its displacements.
-    let mut starts: BTreeMap<String, (f64, Option<regimes::RegimeSet>)> = BTreeMap::new();
+    let mut starts: BTreeMap<String, (f64, Option<&'static str>)> = BTreeMap::new();
     for b in gauge.blocks.iter().filter(|b| b.term == "F") {
-        let family = regimes::regime_set(&base, &b.experiment);
-        let held = family.held_out();
+        let rule = regimes::regime_set(&base, &b.experiment);
+        let held = rule.held_out();
         let from = regs.iter().rfind(|r| r.experiment == b.experiment).filter(|r| r.name == held).map(|r| r.from);
         let quarter = b.x[0] + 0.75 * (b.x[b.x.len() - 1] - b.x[0]);
-        starts.insert(b.experiment.clone(), (from.unwrap_or(quarter), from.map(|_| family)));
+        starts.insert(b.experiment.clone(), (from.unwrap_or(quarter), from.map(|_| rule.held_out_label())));
     }
     let split = |exp: &str| starts.get(exp).map_or(f64::INFINITY, |s| s.0);
-    let kinds: Vec<Option<regimes::RegimeSet>> = starts.values().map(|s| s.1).collect();
-    let held_label = match kinds.first() {
-        Some(Some(f)) if kinds.iter().all(|g| *g == Some(*f)) => f.held_out_label(),
-        Some(None) if kinds.iter().all(Option::is_none) => "last quarter of each curve",
+    let labels: Vec<Option<&str>> = starts.values().map(|s| s.1).collect();
+    let held_label = match labels.first() {
+        Some(Some(l)) if labels.iter().all(|g| *g == Some(*l)) => l,
+        Some(None) if labels.iter().all(Option::is_none) => "last quarter of each curve",
         _ => "last regime or quarter of each curve",
     };
     let early = gauge.restricted(|e, x| x < split(e));

@@ -171,34 +171,4 @@ impl Family {
         let models: BTreeMap<String, Box<dyn ForwardModel>> = [(self.name().to_string(), model)].into();
         Ok(Setup { law, models })
     }
-
-    /// A planted effect at a realistic size: values per parameter of the candidate `name`, or
-    /// `None` when the family does not plant it.
-    pub fn plant(&self, name: &str, rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
-        let sign = |rng: &mut ChaCha8Rng| if rng.random::<bool>() { 1.0 } else { -1.0 };
-        Some(match (self, name) {
-            // Bridging tails of 0.3–1.5 MPa over 0.5–2 mm openings: 0.1–1.5 N/mm of extra toughness.
-            (Family::Dcb, "fibre_bridging") => vec![rng.random_range(0.3..1.5), rng.random_range(0.5..2.0)],
-            (Family::Dcb, "large_rotation") => vec![1.0],
-            // 0.5–2 × h/(2 E22) for the specimen's arms (2.2e-4 mm/MPa).
-            (Family::Dcb, "root_compliance") => vec![rng.random_range(1.1e-4..4.4e-4)],
-            // 2–8 mm/kN: a light load train, 5–20 % of the specimen's initial compliance.
-            (Family::Dcb, "machine_compliance") => vec![rng.random_range(2e-3..8e-3)],
-            (Family::Dcb, "crack_length_offset") => vec![sign(rng) * rng.random_range(1.0..4.0)],
-            (Family::Dcb, "displacement_offset") => vec![sign(rng) * rng.random_range(0.2..0.8)],
-            // An effective G13 between 1/(1/G13 + 2e-4) and 1/(1/G13 + 8e-4): 30–65 % of nominal.
-            (Family::Dcb, "shear_compliance") => vec![rng.random_range(2e-4..8e-4)],
-            // Adhesive 1–2 mm thick of shear modulus 2–5 GPa: t_a/G_a = 2e-4–1e-3 mm/MPa.
-            (Family::Beam, "adhesive_compliance") => vec![rng.random_range(2e-4..1e-3)],
-            // The same layer in peeling, E_a = 5–12 GPa: t_a/E_a = 1e-4–4e-4 mm/MPa.
-            (Family::Beam, "adhesive_normal_compliance") => vec![rng.random_range(1e-4..4e-4)],
-            // Drying shrinkage of the concrete after the plate was bonded: 100–300 µε.
-            (Family::Beam, "shrinkage_strain") => vec![-rng.random_range(1e-4..3e-4)],
-            // Bars hardening at 0.25–0.75 % or 1.25–2.25 % of E_s instead of the assumed 1 %.
-            (Family::Beam, "steel_hardening") => vec![sign(rng) * rng.random_range(500.0..1500.0)],
-            // Seating of the supports and load points: 0.3–1.5 mm.
-            (Family::Beam, "deflection_offset") => vec![rng.random_range(0.3..1.5)],
-            _ => return None,
-        })
-    }
 }

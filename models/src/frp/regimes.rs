@@ -26,8 +26,8 @@
 //! the first step), so its own curves have no uncracked stage: their first stiffness loss is the
 //! bond leaving its elastic branch at the crack mouths, which this rule then reports as cracking.
 
-use super::Regime;
-use crate::diagnose::noise;
+use czid_core::noise;
+use czid_core::regimes::{RegimeRule, Span};
 
 /// Regime names, in test order.
 pub const NAMES: [&str; 4] = ["uncracked", "cracked", "yielded", "debonding"];
@@ -192,9 +192,28 @@ pub fn length_onset(x: &[f64], l: &[f64]) -> Option<usize> {
     }
 }
 
+/// The rule of an FRP-strengthened beam test (module documentation), declared by
+/// [`crate::frp::beam::FrpBeam`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BeamRegimes;
+
+impl RegimeRule for BeamRegimes {
+    fn names(&self) -> &'static [&'static str] {
+        &NAMES
+    }
+
+    fn held_out_label(&self) -> &'static str {
+        "debonding regime of each curve"
+    }
+
+    fn split(&self, load: (&[f64], &[f64]), length: Option<(&[f64], &[f64])>) -> Vec<Span> {
+        split(load.0, load.1, length)
+    }
+}
+
 /// Splits a beam test into its regimes: load curve `(x, p)` (mid-span deflection in mm, load in
 /// N) and, when measured, the debonded length `(x, l)` (mm) on its own abscissae.
-pub fn split(experiment: &str, x: &[f64], p: &[f64], length: Option<(&[f64], &[f64])>) -> Vec<Regime> {
+pub fn split(x: &[f64], p: &[f64], length: Option<(&[f64], &[f64])>) -> Vec<Span> {
     let n = x.len().min(p.len());
     if n == 0 {
         return Vec::new();
@@ -214,7 +233,7 @@ pub fn split(experiment: &str, x: &[f64], p: &[f64], length: Option<(&[f64], &[f
     let from = (0..n).find(|&i| p[i] >= FIRST_LOAD * p[peak]).unwrap_or(0);
     let upto = (from..n).take_while(|&i| x[i] <= fit_end).count();
     let knees = trilinear(&x[from..from + upto], &p[from..from + upto]);
-    let mut bounds: Vec<(&str, f64)> = vec![(NAMES[0], x[0])];
+    let mut bounds: Vec<(&'static str, f64)> = vec![(NAMES[0], x[0])];
     if let Some(t) = knees {
         let loses = |a: f64, b: f64| a > 0.0 && b <= (1.0 - STIFFNESS_LOSS) * a;
         if loses(t.slopes[0], t.slopes[1]) {
@@ -233,7 +252,7 @@ pub fn split(experiment: &str, x: &[f64], p: &[f64], length: Option<(&[f64], &[f
     for (k, (name, a)) in bounds.iter().enumerate() {
         let b = bounds.get(k + 1).map_or(end, |q| q.1);
         if b > *a {
-            out.push(Regime { experiment: experiment.into(), name: (*name).into(), from: *a, to: b });
+            out.push(Span { name, from: *a, to: b });
         }
     }
     out
@@ -269,8 +288,8 @@ mod tests {
     #[test]
     fn too_few_readings_give_no_fit_and_no_panic() {
         assert!(trilinear(&[0.0, 1.0, 2.0], &[0.0, 1.0, 2.0]).is_none());
-        assert!(split("t", &[], &[], None).is_empty());
-        let r = split("t", &[0.0, 1.0], &[0.0, 1.0], None);
+        assert!(split(&[], &[], None).is_empty());
+        let r = split(&[0.0, 1.0], &[0.0, 1.0], None);
         assert_eq!(r.len(), 1);
         assert_eq!(r[0].name, NAMES[0]);
     }
