@@ -131,13 +131,18 @@ impl CompositeObjective {
     /// `f = 1` there: α_i = 1 / (m ||φ_i||²), m the number of terms with a misfit. Terms that
     /// already fit exactly keep α_i = 1.
     pub fn balance_at(&mut self, record: &Record) -> Result<()> {
-        let parts = self.evaluate(record)?.terms;
-        let m = parts.iter().filter(|&&s| s > 0.0).count().max(1) as f64;
-        for (t, s) in self.terms.iter_mut().zip(parts) {
-            t.weight = if s > 0.0 { 1.0 / (m * s) } else { 1.0 };
-        }
-        Ok(())
+        let weights = balanced_weights(&self.evaluate(record)?.terms);
+        self.set_weights(&weights)
     }
+}
+
+/// The weights that make every term contribute equally and the objective 1, from the terms'
+/// unweighted values `||φ_i||²` (of one objective or of several side by side): α_i = 1 / (m
+/// ||φ_i||²), m the number of terms with a misfit. Terms that already fit exactly keep α_i = 1
+/// and do not count.
+pub fn balanced_weights(parts: &[f64]) -> Vec<f64> {
+    let m = parts.iter().filter(|&&s| s > 0.0).count().max(1) as f64;
+    parts.iter().map(|&s| if s > 0.0 { 1.0 / (m * s) } else { 1.0 }).collect()
 }
 
 #[cfg(test)]

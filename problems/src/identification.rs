@@ -2,10 +2,12 @@
 //! parameters to identify, and the composite objective, presented to optimizers as a
 //! [`Problem`] on the unit cube.
 
+use czid_core::objective::balanced_weights;
 use czid_core::{
     columns, CohesiveLaw, ColumnResponse, CompositeObjective, CzError, Evaluation, ForwardModel, ObjectiveTerm,
     ParameterSpace, Problem, Record, Result,
 };
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -38,11 +40,13 @@ impl Setup {
 }
 
 /// Which responses an experiment contributes to the objective.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Term {
     /// Load against displacement (φ_F).
+    #[serde(rename = "F")]
     Load,
     /// Debonded length against displacement (φ_L).
+    #[serde(rename = "L")]
     DebondedLength,
 }
 
@@ -54,6 +58,36 @@ impl Term {
             Term::DebondedLength => "L",
         }
     }
+
+    /// What it is, in words.
+    pub fn noun(self) -> &'static str {
+        match self {
+            Term::Load => "load",
+            Term::DebondedLength => "debonded length",
+        }
+    }
+
+    /// Its unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Term::Load => "N",
+            Term::DebondedLength => "mm",
+        }
+    }
+
+    /// The record column it is read from (against [`columns::DISPLACEMENT`]).
+    pub fn column(self) -> &'static str {
+        match self {
+            Term::Load => columns::LOAD,
+            Term::DebondedLength => columns::DEBONDED_LENGTH,
+        }
+    }
+}
+
+impl std::fmt::Display for Term {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.symbol())
+    }
 }
 
 /// One experiment's data and objective.
@@ -62,6 +96,48 @@ struct Fit {
     name: String,
     objective: CompositeObjective,
     kinds: Vec<Term>,
+}
+
+/// The runs of a setup's experiments: a record per experiment (partial when a run stopped part
+/// way) and the messages of the runs that stopped.
+#[derive(Debug)]
+pub struct Runs {
+    /// Record per experiment.
+    pub records: BTreeMap<String, Record>,
+    /// Messages of runs that failed part way, `experiment: why`.
+    pub failures: Vec<String>,
+}
+
+/// Simulates the experiments `names` of `setup`, in parallel (each run is independent, so the
+/// result does not depend on the number of threads). A run that fails part way is kept with its
+/// converged steps (an objective then holds its last value), and its message is reported; a run
+/// with fewer than two steps, or an experiment without a model, is an error. Identifications and
+/// diagnoses both simulate through here.
+pub fn simulate_experiments(setup: &Setup, names: &[&str]) -> Result<Runs> {
+    let runs: Vec<Result<(Record, Option<String>)>> = names
+        .par_iter()
+        .map(|name| {
+            let model = setup
+                .models
+                .get(*name)
+                .ok_or_else(|| CzError::config(format!("experiment `{name}`"), "has no forward model in the setup"))?;
+            match model.simulate(setup.law.as_ref()) {
+                Ok(r) => Ok((r, None)),
+                Err(f) if f.partial.rows() >= 2 => {
+                    let message = format!("{name}: {f}");
+                    Ok((f.partial, Some(message)))
+                }
+                Err(f) => Err(CzError::Simulation(format!("{name}: {f}"))),
+            }
+        })
+        .collect();
+    let mut out = Runs { records: BTreeMap::new(), failures: Vec::new() };
+    for (name, run) in names.iter().zip(runs) {
+        let (record, failure) = run?;
+        out.failures.extend(failure);
+        out.records.insert(name.to_string(), record);
+    }
+    Ok(out)
 }
 
 /// The result of simulating one candidate.
@@ -160,10 +236,11 @@ impl Identification {
             .iter()
             .map(|fit| Ok(fit.objective.evaluate(&outcome.records[&fit.name])?.terms))
             .collect::<Result<_>>()?;
-        // Terms that already fit exactly cannot be balanced; they keep α = 1 and do not count.
-        let m = parts.iter().flatten().filter(|&&s| s > 0.0).count().max(1) as f64;
+        // One balance over every experiment's terms side by side.
+        let all: Vec<f64> = parts.iter().flatten().copied().collect();
+        let mut weights = balanced_weights(&all).into_iter();
         for (fit, parts) in self.fits.iter_mut().zip(parts) {
-            let w: Vec<f64> = parts.iter().map(|&s| if s > 0.0 { 1.0 / (m * s) } else { 1.0 }).collect();
+            let w: Vec<f64> = weights.by_ref().take(parts.len()).collect();
             fit.objective.set_weights(&w)?;
         }
         Ok(())
@@ -197,29 +274,20 @@ impl Identification {
     pub fn simulate(&self, x: &[f64]) -> Result<Outcome> {
         let setup = self.configure(x)?;
         let kinds = self.term_kinds();
+        let names: Vec<&str> = self.fits.iter().map(|f| f.name.as_str()).collect();
+        let Runs { records, failures } = simulate_experiments(&setup, &names)?;
         let mut objectives = vec![0.0; kinds.len()];
         let mut residuals = Vec::new();
-        let mut records = BTreeMap::new();
-        let mut failures = Vec::new();
         let mut value = 0.0;
         for fit in &self.fits {
-            let model = &setup.models[&fit.name];
-            let record = match model.simulate(setup.law.as_ref()) {
-                Ok(r) => r,
-                Err(f) if f.partial.rows() >= 2 => {
-                    failures.push(format!("{}: {}", fit.name, f));
-                    f.partial
-                }
-                Err(f) => return Err(CzError::Simulation(format!("{}: {}", fit.name, f))),
-            };
-            let v = fit.objective.evaluate(&record)?;
+            let record = &records[&fit.name];
+            let v = fit.objective.evaluate(record)?;
             for ((kind, part), term) in fit.kinds.iter().zip(&v.terms).zip(fit.objective.terms()) {
                 let slot = kinds.iter().position(|k| k == kind).expect("kinds cover every term");
                 objectives[slot] += term.weight * part;
             }
             value += v.value;
-            residuals.extend(fit.objective.residuals(&record)?);
-            records.insert(fit.name.clone(), record);
+            residuals.extend(fit.objective.residuals(record)?);
         }
         Ok(Outcome { evaluation: Evaluation { value, objectives, residuals }, records, failures })
     }

@@ -3,10 +3,9 @@
 //! score statistics of the candidate effects can be compared with their χ² thresholds.
 
 use crate::data::Experiment;
-use crate::identification::{Setup, Term};
+use crate::identification::{simulate_experiments, Runs, Setup, Term};
 use czid_core::noise;
 use czid_core::{columns, CzError, Record, Result};
-use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -15,8 +14,8 @@ use std::collections::BTreeMap;
 pub struct Block {
     /// Experiment name.
     pub experiment: String,
-    /// `F` (load, N) or `L` (debonded length, mm).
-    pub term: String,
+    /// Load (N) or debonded length (mm); serialised as `F` or `L`.
+    pub term: Term,
     /// Displacements of the readings (mm).
     pub x: Vec<f64>,
     /// Measured values (N or mm).
@@ -55,6 +54,13 @@ pub struct Misfit {
 }
 
 impl Misfit {
+    /// The misfit of `setup` on `gauge`: its experiments simulated through the path every
+    /// identification uses ([`simulate_experiments`]), compared reading by reading.
+    pub fn of(gauge: &Gauge, setup: &Setup) -> Result<Misfit> {
+        let Runs { records, failures } = simulate_experiments(setup, &gauge.experiments())?;
+        Ok(Misfit { r: gauge.residuals(&records)?, records, failures })
+    }
+
     /// Sum of squares (χ²-like).
     pub fn rss(&self) -> f64 {
         self.r.iter().map(|v| v * v).sum()
@@ -71,7 +77,7 @@ impl Gauge {
             let sigma = noise_levels.load.unwrap_or_else(|| noise::estimate(&x, &y, false));
             blocks.push(Block {
                 experiment: e.name.clone(),
-                term: Term::Load.symbol().into(),
+                term: Term::Load,
                 x,
                 y,
                 sigma,
@@ -83,7 +89,7 @@ impl Gauge {
                     let sigma = noise_levels.length.unwrap_or_else(|| noise::estimate(&x, &y, true));
                     blocks.push(Block {
                         experiment: e.name.clone(),
-                        term: Term::DebondedLength.symbol().into(),
+                        term: Term::DebondedLength,
                         x,
                         y,
                         sigma,
@@ -95,7 +101,7 @@ impl Gauge {
         for b in &blocks {
             if !(b.sigma > 0.0 && b.sigma.is_finite()) {
                 return Err(CzError::invalid(
-                    format!("noise of {}:{}", b.term, b.experiment),
+                    format!("noise of {}:{}", b.term.symbol(), b.experiment),
                     "sigma",
                     b.sigma,
                     "must be positive and finite (give it with --noise-load / --noise-length)",
@@ -144,52 +150,28 @@ impl Gauge {
 
     /// Model value of a block's response at its readings.
     pub fn model_values(block: &Block, record: &Record) -> Result<Vec<f64>> {
-        let column = if block.term == Term::Load.symbol() { columns::LOAD } else { columns::DEBONDED_LENGTH };
-        let curve = record.curve(columns::DISPLACEMENT, column)?;
+        let curve = record.curve(columns::DISPLACEMENT, block.term.column())?;
         Ok(curve.sample(&block.x))
     }
 
-    /// Simulates every experiment of `setup` that the gauge measures and returns the misfit.
-    /// A run that stops part way is compared on its converged steps (its last value held), as in
-    /// an identification; a run with fewer than two steps is an error.
-    pub fn evaluate(&self, setup: &Setup) -> Result<Misfit> {
+    /// The experiments the gauge measures, in block order (each once).
+    pub fn experiments(&self) -> Vec<&str> {
         let mut names: Vec<&str> = self.blocks.iter().map(|b| b.experiment.as_str()).collect();
         names.dedup();
-        let runs: Vec<Result<(String, Record, Option<String>)>> = names
-            .par_iter()
-            .map(|name| {
-                let model = setup.models.get(*name).ok_or_else(|| {
-                    CzError::config(format!("experiment `{name}`"), "has no forward model in the setup")
-                })?;
-                match model.simulate(setup.law.as_ref()) {
-                    Ok(r) => Ok((name.to_string(), r, None)),
-                    Err(f) if f.partial.rows() >= 2 => {
-                        let message = format!("{name}: {f}");
-                        Ok((name.to_string(), f.partial, Some(message)))
-                    }
-                    Err(f) => Err(CzError::Simulation(format!("{name}: {f}"))),
-                }
-            })
-            .collect();
-        let mut records = BTreeMap::new();
-        let mut failures = Vec::new();
-        for run in runs {
-            let (name, record, failure) = run?;
-            failures.extend(failure);
-            records.insert(name, record);
-        }
-        let mut r = Vec::with_capacity(self.len());
-        for b in &self.blocks {
-            let model = Self::model_values(b, &records[&b.experiment])?;
-            r.extend(b.y.iter().zip(&model).map(|(y, m)| (y - m) / b.sigma));
-        }
-        Ok(Misfit { r, records, failures })
+        names
     }
 
-    /// [`Gauge::evaluate`] for many setups in parallel (results in input order, so the outcome
-    /// does not depend on the number of threads).
-    pub fn evaluate_all(&self, setups: &[Setup]) -> Vec<Result<Misfit>> {
-        setups.par_iter().map(|s| self.evaluate(s)).collect()
+    /// `(test − model) / σ` for every reading, blocks concatenated, from a record per experiment.
+    pub fn residuals(&self, records: &BTreeMap<String, Record>) -> Result<Vec<f64>> {
+        let mut r = Vec::with_capacity(self.len());
+        for b in &self.blocks {
+            let record = records
+                .get(&b.experiment)
+                .ok_or_else(|| CzError::config(format!("experiment `{}`", b.experiment), "has no simulation record"))?;
+            let model = Self::model_values(b, record)?;
+            r.extend(b.y.iter().zip(&model).map(|(y, m)| (y - m) / b.sigma));
+        }
+        Ok(r)
     }
 
     /// Index ranges of the blocks in the residual vector.

@@ -6,7 +6,7 @@
 
 use crate::data::Experiment;
 use crate::diagnose::gauge::{Gauge, Misfit};
-use crate::identification::Setup;
+use crate::identification::{Setup, Term};
 use czid_core::regimes::{GenericRegimes, RegimeRule};
 use serde::Serialize;
 
@@ -44,7 +44,7 @@ pub fn contains(regime: &Regime, x: f64, last: bool) -> bool {
 
 /// The regimes of every experiment of a gauge, from its load curves, by the generic rule.
 pub fn split_all(gauge: &Gauge) -> Vec<Regime> {
-    gauge.blocks.iter().filter(|b| b.term == "F").flat_map(|b| split(&b.experiment, &b.x, &b.y)).collect()
+    gauge.blocks.iter().filter(|b| b.term == Term::Load).flat_map(|b| split(&b.experiment, &b.x, &b.y)).collect()
 }
 
 /// The regime rule of `experiment` in `setup`: its model's (generic when it has no model there).
@@ -58,7 +58,7 @@ pub fn split_setup(gauge: &Gauge, setup: &Setup, experiments: &[Experiment]) -> 
     gauge
         .blocks
         .iter()
-        .filter(|b| b.term == "F")
+        .filter(|b| b.term == Term::Load)
         .flat_map(|b| {
             let length = experiments
                 .iter()
@@ -77,8 +77,8 @@ pub struct RegimeMisfit {
     pub experiment: String,
     /// Regime name.
     pub regime: String,
-    /// `F` (load) or `L` (debonded length).
-    pub term: String,
+    /// Load or debonded length (serialised as `F` or `L`).
+    pub term: Term,
     /// Unit of the means (N or mm).
     pub unit: String,
     /// Readings in the regime.
@@ -129,8 +129,8 @@ pub fn misfit_by_regime(gauge: &Gauge, regimes: &[Regime], misfit: &Misfit) -> V
             out.push(RegimeMisfit {
                 experiment: b.experiment.clone(),
                 regime: reg.name.clone(),
-                term: b.term.clone(),
-                unit: if b.term == "F" { "N".into() } else { "mm".into() },
+                term: b.term,
+                unit: b.term.unit().into(),
                 readings: idx.len(),
                 mean,
                 rms: rms_over_noise * b.sigma,

@@ -22,7 +22,7 @@ fn plots(d: &Diagnosis, out: &OutputDir) -> Result<Vec<String>> {
     let Some(gauge) = &d.gauge else { return Ok(Vec::new()) };
     let mut files = Vec::new();
     for (b, range) in gauge.blocks.iter().zip(gauge.ranges()) {
-        let (what, unit) = if b.term == "F" { ("load", "N") } else { ("debonded length", "mm") };
+        let (what, unit) = (b.term.noun(), b.term.unit());
         let r: Vec<f64> = d.base_residuals[range].iter().map(|v| v * b.sigma).collect();
         let mut fig = Figure::new(
             &format!("{}: {what} residual (test − model)", b.experiment),
@@ -35,11 +35,11 @@ fn plots(d: &Diagnosis, out: &OutputDir) -> Result<Vec<String>> {
         for g in d.regimes.iter().filter(|g| g.experiment == b.experiment).skip(1) {
             fig = fig.with_vline(&g.name, g.from);
         }
-        let name = format!("residual-{}-{}.png", b.experiment, b.term);
+        let name = format!("residual-{}-{}.png", b.experiment, b.term.symbol());
         fig.save(&out.file(&name))?;
         files.push(name);
 
-        let column = if b.term == "F" { columns::LOAD } else { columns::DEBONDED_LENGTH };
+        let column = b.term.column();
         let mut fit =
             Figure::new(&format!("{}: {what}", b.experiment), "displacement (mm)", &format!("{what} ({unit})"))
                 .with(Series::points("test", b.x.clone(), b.y.clone()));
@@ -56,7 +56,7 @@ fn plots(d: &Diagnosis, out: &OutputDir) -> Result<Vec<String>> {
         for g in d.regimes.iter().filter(|g| g.experiment == b.experiment).skip(1) {
             fit = fit.with_vline(&g.name, g.from);
         }
-        let name = format!("fit-{}-{}.png", b.experiment, b.term);
+        let name = format!("fit-{}-{}.png", b.experiment, b.term.symbol());
         fit.save(&out.file(&name))?;
         files.push(name);
     }

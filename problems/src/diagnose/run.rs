@@ -7,7 +7,7 @@ use crate::diagnose::regimes::{self, Regime, RegimeMisfit};
 use crate::diagnose::score::{self, Linearisation, Score, Sensitivity};
 use crate::diagnose::stats::chi2_survival;
 use crate::identifiability::{assess_jacobian, FD_STEP};
-use crate::identification::Setup;
+use crate::identification::{Setup, Term};
 use crate::identify::optimize;
 use crate::problem_file::LoadedProblem;
 use czid_core::{Budget, CzError, Observer, Parameter, ParameterSpace, Progress, Record, Result};
@@ -212,8 +212,8 @@ pub struct Confusable {
 pub struct NoiseReport {
     /// Experiment.
     pub experiment: String,
-    /// `F` or `L`.
-    pub term: String,
+    /// Load or debonded length (serialised as `F` or `L`).
+    pub term: Term,
     /// Standard deviation.
     pub sigma: f64,
     /// `N` or `mm`.
@@ -284,7 +284,7 @@ fn base_residuals<'a>(
     base: &'a Setup,
     space: &'a ParameterSpace,
 ) -> impl Fn(&[f64]) -> Result<Vec<f64>> + Sync + 'a {
-    move |u: &[f64]| Ok(gauge.evaluate(&space.apply(base, &space.from_unit(u))?)?.r)
+    move |u: &[f64]| Ok(Misfit::of(gauge, &space.apply(base, &space.from_unit(u))?)?.r)
 }
 
 /// A candidate's extended model: fitted parameters then the effect's, unit-cube coordinates.
@@ -299,7 +299,7 @@ fn extended<'a>(
         let p = space.dim();
         let fitted = space.apply(base, &space.from_unit(&v[..p]))?;
         let values: Vec<f64> = params.iter().zip(&v[p..]).map(|(q, &u)| q.from_unit(u)).collect();
-        gauge.evaluate(&c.apply(&fitted, &values)?)
+        Misfit::of(gauge, &c.apply(&fitted, &values)?)
     }
 }
 
@@ -429,7 +429,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     let u = fit.u.clone();
     let x = space.from_unit(&u);
     let fitted = space.apply(&base, &x)?;
-    let misfit = gauge.evaluate(&fitted)?;
+    let misfit = Misfit::of(&gauge, &fitted)?;
     let chi2 = misfit.rss();
     let dof = n.saturating_sub(p).max(1);
     let p_noise = chi2_survival(chi2, dof as f64);
@@ -524,7 +524,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     // The held-out part of each curve: its family's held-out regime when that is its last regime
     // (the late stage; a beam's debonding), else the last quarter of its displacements.
     let mut starts: BTreeMap<String, (f64, Option<&'static str>)> = BTreeMap::new();
-    for b in gauge.blocks.iter().filter(|b| b.term == "F") {
+    for b in gauge.blocks.iter().filter(|b| b.term == Term::Load) {
         let rule = regimes::regime_set(&base, &b.experiment);
         let held = rule.held_out();
         let from = regs.iter().rfind(|r| r.experiment == b.experiment).filter(|r| r.name == held).map(|r| r.from);
@@ -545,7 +545,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         say(&format!("base fit without the {held_label} (held out)"));
         let fe = base_residuals(&early, &base, &space);
         let r = lsq::minimize_from(&fe, &u, &[], &REFIT, Some(select_rows(&lin.jac, &early_rows)))?;
-        let predicted = late.evaluate(&space.apply(&base, &space.from_unit(&r.u))?)?;
+        let predicted = Misfit::of(&late, &space.apply(&base, &space.from_unit(&r.u))?)?;
         Some(predicted.rss())
     } else {
         None
@@ -565,7 +565,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
                 .collect();
             let sub = ParameterSpace::new(idx.iter().map(|&j| space.parameters()[j].clone()).collect())?;
             let xs: Vec<f64> = idx.iter().map(|&j| x[j]).collect();
-            let chi = g.evaluate(&sub.apply(&setup, &xs)?)?.rss();
+            let chi = Misfit::of(&g, &sub.apply(&setup, &xs)?)?.rss();
             Ok((w.path.display().to_string(), g, setup, sub, idx.iter().map(|&j| j as f64).collect(), chi))
         })
         .collect::<Result<_>>()?;
@@ -753,7 +753,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
             };
             if note.is_none() {
                 let xs: Vec<f64> = idx.iter().map(|&j| xv[j as usize]).collect();
-                let predicted = sub.apply(setup, &xs).and_then(|s| c.apply(&s, &ev)).and_then(|s| g.evaluate(&s));
+                let predicted = sub.apply(setup, &xs).and_then(|s| c.apply(&s, &ev)).and_then(|s| Misfit::of(g, &s));
                 match predicted {
                     Ok(m) => {
                         tr.effect_chi2 = Some(m.rss());
@@ -783,9 +783,9 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         .iter()
         .map(|b| NoiseReport {
             experiment: b.experiment.clone(),
-            term: b.term.clone(),
+            term: b.term,
             sigma: b.sigma,
-            unit: if b.term == "F" { "N".into() } else { "mm".into() },
+            unit: b.term.unit().into(),
             estimated: b.sigma_estimated,
         })
         .collect();
@@ -823,7 +823,7 @@ pub fn verdict(
 ) -> String {
     let mut out = String::new();
     if let Some(m) = misfit.iter().max_by(|a, b| a.share.total_cmp(&b.share)) {
-        let what = if m.term == "F" { "load" } else { "debonded length" };
+        let what = m.term.noun();
         out.push_str(&format!(
             "The misfit sits mostly in the {} regime of {} ({} of it; {what}: {}, mean test − model {:+.3} {}).",
             m.regime,

@@ -15,11 +15,12 @@
 //! parameter absorbs it (and how far it has moved to do so).
 
 use crate::diagnose::candidate::{CandidateEffect, EffectParameter};
-use crate::diagnose::gauge::Gauge;
+use crate::diagnose::gauge::{Gauge, Misfit};
 use crate::diagnose::stats::chi2_survival;
 use crate::identification::Setup;
 use czid_core::{ParameterSpace, Result, Scale};
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Finite-difference step of the effect sensitivities, in units of each parameter's range: as the
@@ -156,7 +157,7 @@ pub fn sensitivities(
         .filter_map(|p| p.as_mut().ok())
         .flat_map(|(_, jobs)| jobs.iter_mut().filter_map(|j| j.setup.take()))
         .collect();
-    let mut results = gauge.evaluate_all(&setups).into_iter();
+    let mut results = setups.par_iter().map(|s| Misfit::of(gauge, s)).collect::<Vec<_>>().into_iter();
     let n = r0.len();
     let mut out = Vec::new();
     for (ci, prep) in prepared.into_iter().enumerate() {
