@@ -8,7 +8,8 @@
 //! * [`candidate`]: the [`CandidateEffect`] plug-in trait and the bundled [`Library`].
 //! * [`score`]: score statistics at the base fit, confounding, absorbing parameter.
 //! * [`lsq`]: bounded Levenberg–Marquardt for the base polish and the refits.
-//! * [`run`]: the whole diagnosis ([`run::diagnose`]) and its report ([`report`]).
+//! * [`run`]: the whole diagnosis ([`run::diagnose`]), its outline calling the [`stages`] in
+//!   turn, and its report ([`report`]).
 //! * [`bench`]: planted-effect cases with a known answer.
 
 pub mod bench;
@@ -19,6 +20,7 @@ pub mod regimes;
 pub mod report;
 pub mod run;
 pub mod score;
+pub mod stages;
 pub mod stats;
 
 pub use candidate::{BridgingTail, CandidateEffect, Declared, EffectParameter, Library};

@@ -1,7 +1,6 @@
 //! The diagnosis written out: `gap.json`, `report.md` and plots (residuals with the regimes
 //! marked, fits with and without the best candidate, candidate scores).
 
-use crate::diagnose::gauge::Gauge;
 use crate::diagnose::run::Diagnosis;
 use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
@@ -101,16 +100,36 @@ fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or("–".into(), |v| format!("{v:.digits$}"))
 }
 
-/// The report in Markdown.
+/// The report in Markdown: verdict, noise, base fit, where, which, how far, plots.
 pub fn markdown(d: &Diagnosis, plots: &[String]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Sim-to-real gap: {}\n", d.problem);
     let _ = writeln!(s, "**Verdict.** {}\n", d.verdict);
     let _ = writeln!(s, "{} readings; diagnosis took {:.1} s.\n", d.readings, d.wall_seconds);
+    noise_section(&mut s, d);
+    base_section(&mut s, d);
+    where_section(&mut s, d);
+    which_section(&mut s, d);
+    how_far_section(&mut s, d);
+    if !plots.is_empty() {
+        let _ = writeln!(s, "\n## Plots\n");
+        for p in plots {
+            let _ = writeln!(s, "![{p}]({p})");
+        }
+    }
+    s
+}
+
+/// Noise per response.
+fn noise_section(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "## Noise\n\n| experiment | response | σ | estimated from the data |\n|---|---|---|---|");
     for n in &d.noise {
         let _ = writeln!(s, "| {} | {} | {:.4} {} | {} |", n.experiment, n.term, n.sigma, n.unit, n.estimated);
     }
+}
+
+/// The base fit and what the data say about its parameters.
+fn base_section(s: &mut String, d: &Diagnosis) {
     let b = &d.base;
     let _ = writeln!(
         s,
@@ -140,6 +159,10 @@ pub fn markdown(d: &Diagnosis, plots: &[String]) -> String {
         id.singular_values.iter().map(|v| format!("{v:.3e}")).collect::<Vec<_>>().join(", "),
         id.collinearity_index
     );
+}
+
+/// The regimes and the misfit in each.
+fn where_section(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "## Where\n\n| experiment | regime | displacements (mm) |\n|---|---|---|");
     for g in &d.regimes {
         let _ = writeln!(s, "| {} | {} | {:.3} – {:.3} |", g.experiment, g.name, g.from, g.to);
@@ -165,6 +188,10 @@ pub fn markdown(d: &Diagnosis, plots: &[String]) -> String {
             m.sign
         );
     }
+}
+
+/// The candidates' scores at the base fit.
+fn which_section(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         s,
         "\n## Which: candidate effects at the base fit\n\n| candidate | score | dof | p | significant | explained (1st order) | angle to fitted (°) | absorbed by | predicted size |\n|---|---|---|---|---|---|---|---|---|"
@@ -204,6 +231,10 @@ pub fn markdown(d: &Diagnosis, plots: &[String]) -> String {
             let _ = writeln!(s, "* {} and {}: {:.3}", c.a, c.b, c.cos);
         }
     }
+}
+
+/// The refits, their transfer and their shrinkage per regime.
+fn how_far_section(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         s,
         "\n## How far: refits with the effect on\n\n| candidate | χ² | shrinkage | ΔAIC | ΔBIC | effect | transfer |\n|---|---|---|---|---|---|---|"
@@ -248,12 +279,4 @@ pub fn markdown(d: &Diagnosis, plots: &[String]) -> String {
             );
         }
     }
-    if !plots.is_empty() {
-        let _ = writeln!(s, "\n## Plots\n");
-        for p in plots {
-            let _ = writeln!(s, "![{p}]({p})");
-        }
-    }
-    let _ = Gauge::len;
-    s
 }
