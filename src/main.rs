@@ -162,8 +162,17 @@ fn ctrl_c_flag() -> Arc<AtomicBool> {
     flag
 }
 
-fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
+/// Reads a problem file and says what reading its data left out.
+fn read_problem(problem: &Path, sets: &[(String, String)]) -> Result<LoadedProblem, CzError> {
     let problem = LoadedProblem::read_with(problem, sets)?;
+    for note in problem.reading_notes() {
+        eprintln!("note: {note}");
+    }
+    Ok(problem)
+}
+
+fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
+    let problem = read_problem(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, false)?;
     let outcome = simulate(&problem, &dir)?;
     println!("curves and plots written to {}", dir.path().display());
@@ -179,7 +188,7 @@ fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Res
 }
 
 fn run_identify(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &RunOptions) -> Result<(), CzError> {
-    let problem = LoadedProblem::read_with(problem, sets)?;
+    let problem = read_problem(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, opts.resume)?;
     let res = identify(&problem, opts, &dir)?;
     if res.partial {
@@ -210,7 +219,7 @@ fn run_synthesize(truth: &Path, out: &Path, force: bool) -> Result<(), CzError> 
 }
 
 fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &CompareOptions) -> Result<(), CzError> {
-    let problem = LoadedProblem::read_with(problem, sets)?;
+    let problem = read_problem(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, false)?;
     let runs = compare(&problem, opts, &dir)?;
     println!("{:<20} {:>6} {:>12} {:>12} {:>10}", "optimizer", "runs", "median f", "success", "median s");

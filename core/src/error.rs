@@ -3,6 +3,17 @@
 
 use thiserror::Error;
 
+/// A value as a reader wants it: plain for ordinary magnitudes, in scientific notation for very
+/// small or large ones (a subnormal would otherwise print as hundreds of zeros).
+fn readable(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && a.is_finite() && !(1e-4..1e9).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// Result with a [`CzError`].
 pub type Result<T, E = CzError> = std::result::Result<T, E>;
 
@@ -10,7 +21,7 @@ pub type Result<T, E = CzError> = std::result::Result<T, E>;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum CzError {
     /// A parameter of a law, model or optimizer is out of its valid range.
-    #[error("invalid parameter `{name}` = {value} in {owner}: {reason}")]
+    #[error("invalid parameter `{name}` = {} in {owner}: {reason}", readable(*.value))]
     InvalidParameter {
         /// What the parameter belongs to (e.g. `law st_czm`).
         owner: String,

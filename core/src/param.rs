@@ -22,6 +22,10 @@ pub enum Scale {
     Log,
 }
 
+/// Most decades a log-scaled parameter may span (physical parameters of a law or a test are known
+/// far better than that).
+const MAX_DECADES: f64 = 12.0;
+
 /// One identified parameter.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -56,8 +60,10 @@ impl Parameter {
         if self.path.is_empty() {
             return Err(CzError::config("parameters", "a parameter has an empty path"));
         }
-        if !self.lower.is_finite() || !self.upper.is_finite() {
-            return Err(CzError::invalid(&owner, "bounds", f64::NAN, "bounds must be finite"));
+        for (name, v) in [("lower", self.lower), ("upper", self.upper)] {
+            if !v.is_finite() {
+                return Err(CzError::invalid(&owner, name, v, "bounds must be finite numbers"));
+            }
         }
         if self.lower >= self.upper {
             return Err(CzError::invalid(
@@ -67,8 +73,32 @@ impl Parameter {
                 format!("lower bound must be below the upper bound {} (are they inverted?)", self.upper),
             ));
         }
-        if self.scale == Scale::Log && self.lower <= 0.0 {
-            return Err(CzError::invalid(&owner, "lower", self.lower, "log scale needs a positive lower bound"));
+        if self.scale == Scale::Log {
+            if self.lower <= 0.0 {
+                return Err(CzError::invalid(&owner, "lower", self.lower, "log scale needs a positive lower bound"));
+            }
+            // A subnormal bound, or bounds many decades apart, are typos (a missing exponent
+            // digit), and the search would spend most of its effort on physically absurd values.
+            if self.lower < f64::MIN_POSITIVE {
+                return Err(CzError::invalid(
+                    &owner,
+                    "lower",
+                    self.lower,
+                    "is below the smallest normal number; give a physically meaningful positive bound",
+                ));
+            }
+            let decades = (self.upper / self.lower).log10();
+            if decades > MAX_DECADES {
+                return Err(CzError::invalid(
+                    &owner,
+                    "lower",
+                    self.lower,
+                    format!(
+                        "the bounds span {decades:.0} decades (more than {MAX_DECADES:.0}) up to {}: is an exponent mistyped?",
+                        self.upper
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -221,6 +251,20 @@ impl ParameterSpace {
     }
 }
 
+/// A deep copy of a configuration through its serde tree: the one way czid copies laws and models,
+/// which are trait objects (`Box<dyn CohesiveLaw>`, `Box<dyn ForwardModel>`) with no `Clone`.
+/// `owner` names what was copied in an error.
+///
+/// ```
+/// # use czid_core::param::duplicate;
+/// let v: Vec<f64> = duplicate(&vec![1.0, 2.0], "values").unwrap();
+/// assert_eq!(v, [1.0, 2.0]);
+/// ```
+pub fn duplicate<T: Serialize + DeserializeOwned>(value: &T, owner: &str) -> Result<T> {
+    let tree = serde_json::to_value(value).map_err(|e| CzError::config(owner, e.to_string()))?;
+    serde_json::from_value(tree).map_err(|e| CzError::config(owner, e.to_string()))
+}
+
 /// The values at a dotted path; a `*` segment matches every key of a table (e.g.
 /// `models.*.material.e11` ties one parameter to every experiment's modulus). Errors list the keys
 /// available where the path breaks.
@@ -274,6 +318,19 @@ mod tests {
         assert_eq!(space.read(&on).unwrap(), vec![1.0]);
         let off: Model = space.apply(&on, &[0.2]).unwrap();
         assert_eq!(space.read(&off).unwrap(), vec![0.0]);
+    }
+
+    #[test]
+    fn absurd_bounds_are_refused_with_the_bound_named() {
+        let err = |p: Parameter| ParameterSpace::new(vec![p]).unwrap_err().to_string();
+        let e = err(Parameter::new("law.u", "mm", 0.0, f64::INFINITY));
+        assert!(e.contains("upper") && e.contains("inf"), "{e}");
+        let e = err(Parameter::new("law.u", "mm", 5e-324, 0.01).log());
+        assert!(e.contains("smallest normal"), "{e}");
+        let e = err(Parameter::new("law.u", "mm", 1e-20, 0.01).log());
+        assert!(e.contains("18 decades"), "{e}");
+        // Realistic log ranges pass (a penalty stiffness over four decades).
+        assert!(ParameterSpace::new(vec![Parameter::new("law.k", "MPa/mm", 1e3, 1e7).log()]).is_ok());
     }
 
     #[test]

@@ -98,6 +98,38 @@ pub struct ExperimentSpec {
     /// end of a test, noise in a seating toe) instead of reporting them as an error.
     #[serde(default)]
     pub drop_non_increasing: bool,
+    /// Drop rows with a missing or non-finite reading (`NaN`, `inf`, an empty cell) in a column
+    /// that is read, instead of reporting them as an error (some test machines write such rows
+    /// when a channel drops out).
+    #[serde(default)]
+    pub drop_non_finite: bool,
+}
+
+/// Rows of a data file that reading left out, by reason.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DroppedRows {
+    /// With a missing or non-finite reading (`drop_non_finite`).
+    pub non_finite: usize,
+    /// Whose displacement does not increase (`drop_non_increasing`).
+    pub non_increasing: usize,
+    /// Outside the displacement `range`.
+    pub out_of_range: usize,
+}
+
+impl DroppedRows {
+    /// What was dropped, in words (`None`: nothing).
+    pub fn describe(&self) -> Option<String> {
+        let parts: Vec<String> = [
+            (self.non_finite, "with a missing or non-finite reading"),
+            (self.non_increasing, "whose displacement does not increase"),
+            (self.out_of_range, "outside the displacement range"),
+        ]
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, why)| format!("{n} {why}"))
+        .collect();
+        (!parts.is_empty()).then(|| format!("rows dropped: {}", parts.join(", ")))
+    }
 }
 
 /// A test's curves in N and mm.
@@ -111,6 +143,8 @@ pub struct Experiment {
     pub debonded_length: Option<Curve>,
     /// First value of a crack-length column (the initial crack length a0, mm), when given.
     pub initial_crack: Option<f64>,
+    /// Rows of the file left out, by reason.
+    pub dropped: DroppedRows,
 }
 
 impl ExperimentSpec {
@@ -143,6 +177,7 @@ impl ExperimentSpec {
 
         let (lu, fu) = (self.length_unit.to_mm(), self.force_unit.to_newton());
         let mut rows: Vec<Row> = Vec::new();
+        let mut dropped = DroppedRows::default();
         for (i, record) in reader.records().enumerate() {
             let row = i + 2;
             let record = record.map_err(|e| CzError::data(format!("{shown}, row {row}"), e.to_string()))?;
@@ -161,12 +196,25 @@ impl ExperimentSpec {
                 }
                 Ok(converted)
             };
-            rows.push(Row {
-                line: row,
-                x: cell(ix, lu)?,
-                y: cell(iy, fu)?,
-                crack: ic.map(|c| cell(c, lu)).transpose()?,
-            });
+            let read = || -> Result<Row> {
+                Ok(Row { line: row, x: cell(ix, lu)?, y: cell(iy, fu)?, crack: ic.map(|c| cell(c, lu)).transpose()? })
+            };
+            match read() {
+                Ok(r) => rows.push(r),
+                Err(_) if self.drop_non_finite && missing_or_non_finite(&record, &[Some(ix), Some(iy), ic]) => {
+                    dropped.non_finite += 1;
+                }
+                Err(e) => {
+                    return Err(if missing_or_non_finite(&record, &[Some(ix), Some(iy), ic]) {
+                        CzError::data(
+                            format!("{shown}, row {row}"),
+                            format!("{e}; set `drop_non_finite = true` to drop such rows"),
+                        )
+                    } else {
+                        e
+                    })
+                }
+            }
         }
         if rows.is_empty() {
             return Err(CzError::data(&shown, "the file has a header but no data rows"));
@@ -185,7 +233,9 @@ impl ExperimentSpec {
                     format!("range [{lo}, {hi}] must have min < max"),
                 ));
             }
+            let before = kept.len();
             kept.retain(|r| r.x >= lo && r.x <= hi);
+            dropped.out_of_range = before - kept.len();
             if kept.is_empty() {
                 return Err(CzError::data(&shown, format!("no rows with displacement in the range [{lo}, {hi}] mm")));
             }
@@ -196,7 +246,9 @@ impl ExperimentSpec {
             if r.x > reach {
                 reach = r.x;
                 monotone.push(r);
-            } else if !self.drop_non_increasing {
+            } else if self.drop_non_increasing {
+                dropped.non_increasing += 1;
+            } else {
                 return Err(CzError::data(
                     format!("{shown}, row {}, column `{}`", r.line, self.displacement),
                     format!(
@@ -206,6 +258,17 @@ impl ExperimentSpec {
                     ),
                 ));
             }
+        }
+        // One reading is no curve: nothing could be fitted to it, and every parameter would look
+        // determined by it.
+        if monotone.len() < 2 {
+            return Err(CzError::data(
+                &shown,
+                format!(
+                    "{} usable reading(s) after the range and dropped rows; a test curve needs at least 2",
+                    monotone.len()
+                ),
+            ));
         }
         let x: Vec<f64> = monotone.iter().map(|r| r.x).collect();
         // A curve the checks above let through can still be refused (a crack length minus its
@@ -223,8 +286,16 @@ impl ExperimentSpec {
             }
         };
         let name = self.file.file_stem().map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
-        Ok(Experiment { name, load, debonded_length, initial_crack })
+        Ok(Experiment { name, load, debonded_length, initial_crack, dropped })
     }
+}
+
+/// Whether a used cell of `record` is empty or reads as a non-finite number (`NaN`, `inf`).
+fn missing_or_non_finite(record: &csv::StringRecord, columns: &[Option<usize>]) -> bool {
+    columns.iter().flatten().any(|&c| {
+        let raw = record.get(c).unwrap_or("");
+        raw.is_empty() || raw.parse::<f64>().is_ok_and(|v| !v.is_finite())
+    })
 }
 
 /// One data row in czid units, with its line number in the file.
@@ -250,6 +321,7 @@ mod tests {
             force_unit: ForceUnit::N,
             range: None,
             drop_non_increasing: false,
+            drop_non_finite: false,
         }
     }
 
@@ -304,7 +376,27 @@ mod tests {
         let dir = write("drop", "Disp,Force,CrackExt\n0,0,1\n2,1,1\n1,1,1\n3,2,1\n");
         let mut s = spec("t.csv");
         s.drop_non_increasing = true;
-        assert_eq!(s.load(&dir).unwrap().load.x(), &[0.0, 2.0, 3.0]);
+        let e = s.load(&dir).unwrap();
+        assert_eq!(e.load.x(), &[0.0, 2.0, 3.0]);
+        assert_eq!(e.dropped, DroppedRows { non_increasing: 1, ..Default::default() });
+    }
+
+    #[test]
+    fn rows_with_missing_or_non_finite_readings_can_be_dropped_and_are_counted() {
+        let text = "Disp,Force,CrackExt\n0,0,1\n1,NaN,1\n2,,1\n3,3,NaN\n4,4,1\n";
+        let dir = write("nan-rows", text);
+        // By default the first such row is an error that says how to drop them.
+        let e = spec("t.csv").load(&dir).unwrap_err().to_string();
+        assert!(e.contains("row 3") && e.contains("drop_non_finite"), "{e}");
+        let mut s = spec("t.csv");
+        s.drop_non_finite = true;
+        let e = s.load(&dir).unwrap();
+        assert_eq!(e.load.x(), &[0.0, 4.0]);
+        assert_eq!(e.dropped, DroppedRows { non_finite: 3, ..Default::default() });
+        assert_eq!(e.dropped.describe().unwrap(), "rows dropped: 3 with a missing or non-finite reading");
+        // A text cell is still an error: it is not a gap in the record but a wrong column.
+        let dir = write("text-row", "Disp,Force,CrackExt\n0,0,1\n1,abc,1\n2,2,1\n");
+        assert!(s.load(&dir).unwrap_err().to_string().contains("`abc` is not a number"));
     }
 
     #[test]

@@ -34,8 +34,7 @@ impl Setup {
 
     /// A deep copy (through serde, as laws and models are trait objects).
     pub fn duplicate(&self) -> Result<Setup> {
-        let v = serde_json::to_value(self).map_err(|e| CzError::config("setup", e.to_string()))?;
-        serde_json::from_value(v).map_err(|e| CzError::config("setup", e.to_string()))
+        czid_core::param::duplicate(self, "setup")
     }
 }
 
@@ -251,6 +250,16 @@ impl Identification {
         for fit in &mut self.fits {
             let w: Vec<f64> = fit.kinds.iter().map(|k| if *k == Term::Load { alpha_f } else { alpha_l }).collect();
             fit.objective.set_weights(&w)?;
+        }
+        // With every weight zero the objective is 0 everywhere and any parameters "fit".
+        if self.weights().iter().all(|(_, w)| *w == 0.0) {
+            return Err(CzError::config(
+                "[objective] weights",
+                format!(
+                    "every compared response has weight 0 (load = {alpha_f}, debonded_length = {alpha_l}), so the \
+                     objective is 0 whatever the parameters; give the load a positive weight"
+                ),
+            ));
         }
         Ok(())
     }

@@ -43,6 +43,7 @@
 
 use crate::data::{Experiment, ExperimentSpec};
 use crate::identification::{Identification, Setup};
+use czid_core::param::duplicate;
 use czid_core::{CohesiveLaw, CzError, ForwardModel, Parameter, ParameterSpace, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -270,6 +271,12 @@ impl LoadedProblem {
         Ok(LoadedProblem { path: path.to_path_buf(), file, experiments })
     }
 
+    /// What reading the data left out, one line per experiment that lost rows (e.g.
+    /// `dcb01: rows dropped: 12 whose displacement does not increase`), for the user to see.
+    pub fn reading_notes(&self) -> Vec<String> {
+        self.experiments.iter().filter_map(|e| e.dropped.describe().map(|d| format!("{}: {d}", e.name))).collect()
+    }
+
     /// The identification problem this file describes (weights set as the file asks).
     pub fn identification(&self) -> Result<Identification> {
         let shown = self.path.display().to_string();
@@ -297,10 +304,10 @@ impl LoadedProblem {
     /// The law and models with their initial values.
     pub fn setup(&self) -> Result<Setup> {
         // Trait objects are copied through serde; the file itself stays untouched.
-        let law: Box<dyn CohesiveLaw> = roundtrip(&self.file.law)?;
+        let law: Box<dyn CohesiveLaw> = duplicate(&self.file.law, "problem")?;
         let mut models = BTreeMap::new();
         for (entry, data) in self.file.experiment.iter().zip(&self.experiments) {
-            models.insert(data.name.clone(), roundtrip(&entry.model)?);
+            models.insert(data.name.clone(), duplicate(&entry.model, "problem")?);
         }
         Ok(Setup { law, models })
     }
@@ -357,9 +364,4 @@ fn set_path(doc: &mut toml::Table, key: &str, value: toml::Value) -> std::result
     }
     node.insert(last.to_string(), value);
     Ok(())
-}
-
-fn roundtrip<T: Serialize + serde::de::DeserializeOwned>(v: &T) -> Result<T> {
-    let j = serde_json::to_value(v).map_err(|e| CzError::config("problem", e.to_string()))?;
-    serde_json::from_value(j).map_err(|e| CzError::config("problem", e.to_string()))
 }

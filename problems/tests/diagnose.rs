@@ -142,6 +142,7 @@ fn diagnose_synthetic(bridging: f64) -> czid_problems::diagnose::Diagnosis {
         load: Curve::new(data.displacement.clone(), data.load).unwrap(),
         debonded_length: Some(Curve::new(data.displacement, data.debonded_length).unwrap()),
         initial_crack: None,
+        dropped: Default::default(),
     };
     let space = ParameterSpace::new(vec![
         Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),

@@ -244,6 +244,7 @@ fn experiment(s: &Synthetic) -> Experiment {
         load: Curve::new(s.displacement.clone(), s.load.clone()).unwrap(),
         debonded_length: Some(Curve::new(s.displacement.clone(), s.debonded_length.clone()).unwrap()),
         initial_crack: None,
+        dropped: Default::default(),
     }
 }
 

@@ -347,6 +347,7 @@ fn csv_data_never_panics_and_what_is_accepted_is_sound() {
             force_unit: [ForceUnit::N, ForceUnit::KiloNewton, ForceUnit::PoundForce][rng.random_range(0..3)],
             range,
             drop_non_increasing: rng.random(),
+            drop_non_finite: rng.random(),
         };
         match spec.load(&dir) {
             Ok(e) => {

@@ -156,6 +156,24 @@ fn bad_inputs_are_named() {
         ("negative", problem_text("").replace("area = 2.0", "area = -2.0"), "area"),
         ("missing-file", problem_text("").replace("patch.csv", "absent.csv"), "absent.csv"),
         ("missing-column", problem_text("").replace("load = \"P\"", "load = \"Q\""), "no column `Q`"),
+        // Guards against inputs that used to give a silently wrong answer.
+        (
+            "zero-weights",
+            problem_text("")
+                .replace("[optimizer]", "[objective]\nweights = { load = 0.0, debonded_length = 0.0 }\n\n[optimizer]"),
+            "weight 0",
+        ),
+        (
+            "one-row",
+            problem_text("").replace("file = \"patch.csv\"", "file = \"patch.csv\"\nrange = [0.5, 0.55]"),
+            "at least 2",
+        ),
+        ("infinite-bound", problem_text("").replace("upper = 200.0", "upper = inf"), "upper"),
+        (
+            "subnormal-log-bound",
+            problem_text("").replace("lower = 10.0\nupper = 200.0", "lower = 5e-324\nupper = 200.0\nscale = \"log\""),
+            "smallest normal",
+        ),
     ];
     for (name, text, expect) in cases {
         let dir = setup_dir(name, &text);

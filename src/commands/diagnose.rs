@@ -75,6 +75,9 @@ fn read_start(path: &Path, problem: &LoadedProblem) -> Result<Vec<f64>, CzError>
 /// Runs the diagnosis and writes its outputs.
 pub fn run(args: &DiagnoseArgs) -> Result<(), CzError> {
     let problem = LoadedProblem::read_with(&args.problem, &args.sets)?;
+    for note in problem.reading_notes() {
+        eprintln!("note: {note}");
+    }
     let library = Library::builtin();
     // Unknown candidate names are reported before any work.
     library.select(&problem.setup()?, &args.candidates)?;

@@ -195,6 +195,7 @@ fn case(
             load: Curve::new(data.displacement.clone(), data.load)?,
             debonded_length: Some(Curve::new(data.displacement, data.debonded_length)?),
             initial_crack: None,
+            dropped: Default::default(),
         };
         let space = family.space();
         let u0: Vec<f64> =
