@@ -190,6 +190,9 @@ pub struct RowScale {
     pub displacement: f64,
     /// Added to the recorded displacement (seating offset).
     pub offset: f64,
+    /// Added to the recorded displacement per unit recorded load (mm/N): a compliant machine
+    /// whose load train is not part of the mesh (see [`crate::measurement::recorded_control`]).
+    pub compliance: f64,
     /// Recorded load per unit reaction.
     pub load: f64,
     /// Whole-specimen energy per unit energy of the simulated part (2 for a half model).
@@ -206,8 +209,14 @@ pub fn to_record(rows: &[StepRow], s: &RowScale) -> Record {
     }
     for r in rows {
         let p = s.load * r.reaction;
+        // Without a compliance the sum is the one the base model always recorded, bit for bit.
+        let delta = if s.compliance == 0.0 {
+            s.displacement * r.control
+        } else {
+            s.displacement * r.control + s.compliance * p
+        };
         rec.push(&[
-            s.displacement * r.control + s.offset,
+            delta + s.offset,
             p,
             r.crack.debonded,
             r.crack.process_zone,

@@ -41,6 +41,7 @@ use crate::beamtest::{self, ControlSettings, Material, MeshSettings, RowScale};
 use crate::effects::Effects;
 use crate::fe::mesh::{graded, NONE};
 use crate::fe::{self, FeProblem, InterfacePoint, Layer, Mesh, PathSettings, PointKind, Section, Spring};
+use crate::measurement::{recorded_control, LoadPoint};
 
 /// Half (symmetric) or full (two-arm) model.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -189,8 +190,7 @@ impl Dcb {
         let tip = x.iter().position(|&v| (v - a).abs() <= 1e-9 * self.length).unwrap_or(0);
         let large = fx.large_rotation;
         let surface = (fx.root_compliance > 0.0).then_some((tip, nn - 1));
-        let machine = fx.machine_compliance > 0.0;
-        let extra = usize::from(machine);
+        let extra = crate::measurement::extra_unknowns(fx.machine_compliance, true);
         let half = self.symmetry == Symmetry::Half;
         let (layers, factor) = if half {
             let up =
@@ -243,32 +243,9 @@ impl Dcb {
         }
         // Opening per unit of the loaded arm's deflection.
         let arm_to_opening = if half { 2.0 } else { 1.0 };
-        let (control, scale) = if machine {
-            // Actuator unknown `a` (the crosshead opening) behind a spring of compliance C_m:
-            // elongation a − δ_specimen. In the half model the spring's energy is shared by the two
-            // halves, hence stiffness ½/C_m with the reaction being half the load.
-            let k = factor / fx.machine_compliance;
-            springs.push(Spring { i: w_up, j: 0, k, ci: arm_to_opening });
-            (
-                0,
-                RowScale {
-                    displacement: 1.0,
-                    offset: fx.displacement_offset,
-                    load: 1.0 / factor,
-                    energy: 1.0 / factor,
-                },
-            )
-        } else {
-            (
-                w_up,
-                RowScale {
-                    displacement: arm_to_opening,
-                    offset: fx.displacement_offset,
-                    load: 1.0,
-                    energy: 1.0 / factor,
-                },
-            )
-        };
+        let load_point = LoadPoint { dof: w_up, per_unit: arm_to_opening, share: factor, at_first_node: true };
+        let (control, scale) =
+            recorded_control(fx.machine_compliance, fx.displacement_offset, load_point, &mut springs);
         let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: large, contact_stiffness: 0.0 };
         Ok((p, scale))
     }

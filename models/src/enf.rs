@@ -152,8 +152,7 @@ impl Enf {
         let s = self.section();
         let lo = Layer { section: s, y: 0.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
         let up = Layer { section: s, y: 1.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
-        let machine = fx.machine_compliance > 0.0;
-        let mesh = Mesh::new(x, vec![lo, up], usize::from(machine))?;
+        let mesh = Mesh::new(x, vec![lo, up], crate::measurement::extra_unknowns(fx.machine_compliance, false))?;
         let mut points = Vec::with_capacity(nn + 1);
         let mut springs = Vec::new();
         for i in 0..nn {
@@ -177,13 +176,15 @@ impl Enf {
         }
         let fixed = vec![mesh.dofs(0, 0)[1], mesh.dofs(0, nn - 1)[1], mesh.dofs(0, nn - 1)[0]];
         let w_load = mesh.dofs(1, mid)[1];
-        let (control, scale) = if machine {
-            // Actuator `a` (crosshead travel, downwards) behind the machine spring: elongation a + w.
-            springs.push(Spring { i: w_load, j: 0, k: 1.0 / fx.machine_compliance, ci: -1.0 });
-            (0, RowScale { displacement: 1.0, offset: fx.displacement_offset, load: 1.0, energy: 1.0 })
-        } else {
-            (w_load, RowScale { displacement: -1.0, offset: fx.displacement_offset, load: -1.0, energy: 1.0 })
-        };
+        // The load nose pushes the upper arm down: recorded deflection and load are positive.
+        let load_point =
+            crate::measurement::LoadPoint { dof: w_load, per_unit: -1.0, share: 1.0, at_first_node: false };
+        let (control, scale) = crate::measurement::recorded_control(
+            fx.machine_compliance,
+            fx.displacement_offset,
+            load_point,
+            &mut springs,
+        );
         let contact_stiffness = self.contact_stiffness.unwrap_or(law.initial_stiffness()[0]);
         let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: false, contact_stiffness };
         Ok((p, scale))

@@ -36,6 +36,32 @@ fn linear_branch_compliance_matches_beam_theory_with_shear() {
 }
 
 #[test]
+fn machine_compliance_and_offset_shift_the_recorded_deflection() {
+    let mut e = Enf::hartlen_enf03();
+    e.control.max_displacement = Some(0.5);
+    e.control.output_points = 2;
+    e.mesh.interface_element = 0.25;
+    let law = TestBilinear::new(1e7, 1e6, 1e6);
+    let run = |e: &Enf| e.simulate(&law).unwrap_or_else(|f| panic!("{}", f.error));
+    let compliance = |r: &Record| col(r, columns::DISPLACEMENT)[1] / col(r, columns::LOAD)[1];
+    let base = run(&e);
+    // The crosshead records δ + C_m P: the elastic compliance grows by exactly C_m.
+    let cm = 2e-3;
+    let mut m = e.clone();
+    m.effects.machine_compliance = cm;
+    let machine = run(&m);
+    assert!((compliance(&machine) - compliance(&base) - cm).abs() < 1e-9 * compliance(&machine));
+    // A seating offset adds an unloaded first row and shifts every deflection.
+    let mut o = e.clone();
+    o.effects.displacement_offset = 0.3;
+    let offset = run(&o);
+    assert_eq!(col(&offset, columns::LOAD)[0], 0.0);
+    let (x0, x1) = (col(&base, columns::DISPLACEMENT), col(&offset, columns::DISPLACEMENT));
+    assert_eq!(x1.len(), x0.len() + 1);
+    assert!(x0.iter().zip(&x1[1..]).all(|(a, b)| (b - a - 0.3).abs() < 1e-12));
+}
+
+#[test]
 fn hartlen_enf_runs_past_the_peak() {
     let mut e = Enf::hartlen_enf03();
     e.control.output_points = 40;

@@ -455,7 +455,10 @@ impl FrpPull {
                 }
             })
             .collect();
-        beamtest::to_record(&rows, &RowScale { displacement: -1.0, offset: 0.0, load: -1.0, energy: 1.0 })
+        beamtest::to_record(
+            &rows,
+            &RowScale { displacement: -1.0, offset: 0.0, compliance: 0.0, load: -1.0, energy: 1.0 },
+        )
     }
 
     fn path(&self, law: &dyn CohesiveLaw) -> PathSettings {
