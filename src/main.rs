@@ -249,11 +249,34 @@ fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &
 const DEMO_OPTIMIZER: &str = "hybrid";
 const DEMO_BUDGET: usize = 2000;
 
+/// The demo's inputs, built into the binary so that `czid demo` runs wherever the binary is (an
+/// installed one has no source tree): the paper-DCB problem file, its synthetic data and how the
+/// data were made.
+const DEMO_INPUTS: [(&str, &str); 3] = [
+    ("problem.toml", include_str!("../examples/paper-dcb/problem.toml")),
+    ("synthetic.csv", include_str!("../examples/paper-dcb/synthetic.csv")),
+    ("truth.toml", include_str!("../examples/paper-dcb/truth.toml")),
+];
+
+/// Writes the demo's inputs into `<out>/inputs` and returns the problem file's path.
+fn write_demo_inputs(out: &Path) -> Result<PathBuf, CzError> {
+    let dir = out.join("inputs");
+    let io = |e: std::io::Error| CzError::Io { path: dir.display().to_string(), message: e.to_string() };
+    std::fs::create_dir_all(&dir).map_err(io)?;
+    for (name, text) in DEMO_INPUTS {
+        czid_problems::output::write_atomic(&dir.join(name), text.as_bytes())?;
+    }
+    Ok(dir.join("problem.toml"))
+}
+
 fn demo(out: &Path) -> Result<(), CzError> {
-    let problem = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/paper-dcb/problem.toml");
+    let problem = write_demo_inputs(out)?;
     println!("czid demo: the paper-DCB study (Shi & Zhang), identifying the six ST-CZM parameters");
     println!("  problem: {}", problem.display());
-    println!("  data:    examples/paper-dcb/synthetic.csv (synthetic: Table 3 parameters + stated noise)");
+    println!(
+        "  data:    {} (synthetic: Table 3 parameters + stated noise, see truth.toml)",
+        problem.with_file_name("synthetic.csv").display()
+    );
     run_identify(
         &problem,
         &[],

@@ -87,3 +87,20 @@ fn bad_input_fails_with_a_message_naming_it() {
         std::fs::remove_dir_all(&out).ok();
     }
 }
+
+#[test]
+fn the_demo_runs_from_an_empty_folder_with_its_inputs_built_in() {
+    // A copy of the binary in an empty folder, run there: nothing may come from the source tree.
+    let dir = scratch("demo");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin = dir.join("czid");
+    std::fs::copy(env!("CARGO_BIN_EXE_czid"), &bin).unwrap();
+    let o = Command::new(&bin).args(["demo", "--out", "out"]).current_dir(&dir).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    for file in ["inputs/problem.toml", "inputs/synthetic.csv", "inputs/truth.toml", "result.json", "fit-load.png"] {
+        assert!(dir.join("out").join(file).exists(), "{file} missing");
+    }
+    let result = std::fs::read_to_string(dir.join("out/result.json")).unwrap();
+    assert!(result.contains("inputs/problem.toml"), "the demo must read its own copy of the inputs");
+    std::fs::remove_dir_all(&dir).ok();
+}
