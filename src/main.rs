@@ -11,7 +11,7 @@ use czid_problems::problem_file::LoadedProblem;
 use czid_problems::synthetic::TruthFile;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// Identify cohesive-zone interface laws from laboratory tests (units: N, mm, MPa).
@@ -131,7 +131,7 @@ fn main() -> ExitCode {
         Command::Demo { out } => demo(&out),
         Command::Simulate { problem, out, set } => run_simulate(&problem, &set.sets, &out),
         Command::Identify { problem, out, set, optimizer, seed, budget, resume } => {
-            let opts = RunOptions { optimizer, seed, budget, progress: true, resume, stop: Some(ctrl_c_flag()) };
+            let opts = RunOptions { optimizer, seed, budget, progress: true, resume, stop: Some(interrupt_flag()) };
             run_identify(&problem, &set.sets, &out, &opts)
         }
         Command::Harness(args) => commands::harness::run(&args),
@@ -143,7 +143,7 @@ fn main() -> ExitCode {
         }
     };
     match outcome {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => exit_after_signal(),
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
@@ -151,15 +151,33 @@ fn main() -> ExitCode {
     }
 }
 
-/// A flag raised by Ctrl-C: the optimizer stops after its current iteration, leaving a checkpoint
-/// and a partial result.
-fn ctrl_c_flag() -> Arc<AtomicBool> {
+/// Exit code of a run stopped by a signal: 128 + the signal's number (130 for SIGINT, 143 for
+/// SIGTERM, what shells and schedulers expect), 0 while no signal came.
+static SIGNAL_EXIT: std::sync::OnceLock<Arc<AtomicUsize>> = std::sync::OnceLock::new();
+
+/// A flag raised by Ctrl-C (SIGINT) or a scheduler's SIGTERM: the optimizer stops after its
+/// current iteration, leaving a checkpoint and a partial result, and the command exits with 130
+/// or 143. A second signal ends the process at once (the checkpoint is already on disk).
+fn interrupt_flag() -> Arc<AtomicBool> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
     let flag = Arc::new(AtomicBool::new(false));
-    let f = flag.clone();
-    // Without a handler (e.g. one is already installed) Ctrl-C simply ends the process, which
-    // loses only the work since the last checkpoint.
-    let _ = ctrlc::set_handler(move || f.store(true, Ordering::SeqCst));
+    let code = SIGNAL_EXIT.get_or_init(|| Arc::new(AtomicUsize::new(0)));
+    for (signal, exit) in [(SIGINT, 130), (SIGTERM, 143)] {
+        // Without handlers (they could not be installed) a signal simply ends the process,
+        // which loses only the work since the last checkpoint.
+        let _ = signal_hook::flag::register_conditional_shutdown(signal, exit as i32, flag.clone());
+        let _ = signal_hook::flag::register_usize(signal, code.clone(), exit);
+        let _ = signal_hook::flag::register(signal, flag.clone());
+    }
     flag
+}
+
+/// The exit code for a command that returned `Ok`: 130 or 143 when a signal stopped it.
+fn exit_after_signal() -> ExitCode {
+    match SIGNAL_EXIT.get().map_or(0, |c| c.load(Ordering::SeqCst)) {
+        0 => ExitCode::SUCCESS,
+        code => ExitCode::from(code as u8),
+    }
 }
 
 /// Reads a problem file and says what reading its data left out.
@@ -285,7 +303,7 @@ fn demo(out: &Path) -> Result<(), CzError> {
             optimizer: Some(DEMO_OPTIMIZER.into()),
             budget: Some(DEMO_BUDGET),
             progress: true,
-            stop: Some(ctrl_c_flag()),
+            stop: Some(interrupt_flag()),
             ..RunOptions::default()
         },
     )?;

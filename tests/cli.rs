@@ -104,3 +104,33 @@ fn the_demo_runs_from_an_empty_folder_with_its_inputs_built_in() {
     assert!(result.contains("inputs/problem.toml"), "the demo must read its own copy of the inputs");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn sigint_and_sigterm_leave_a_partial_result_and_exit_130_and_143() {
+    for (signal, code) in [("-INT", 130), ("-TERM", 143)] {
+        let out = scratch(&format!("signal{signal}"));
+        let child = Command::new(env!("CARGO_BIN_EXE_czid"))
+            .args(["identify", "examples/paper-dcb/problem.toml", "--out", out.to_str().unwrap()])
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Signal once the run is under way (its first checkpoint is written), as a user or a
+        // scheduler would.
+        for _ in 0..600 {
+            if out.join("checkpoint.json").exists() {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        let sent = Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap();
+        assert!(sent.success());
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(code), "{signal}: {}", stderr(&o));
+        assert!(String::from_utf8_lossy(&o.stdout).contains("continue with --resume"), "{signal}");
+        assert!(out.join("result.partial.json").exists(), "{signal}: no partial result");
+        assert!(out.join("checkpoint.json").exists(), "{signal}: no checkpoint");
+        std::fs::remove_dir_all(&out).ok();
+    }
+}
