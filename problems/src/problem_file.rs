@@ -224,7 +224,23 @@ impl LoadedProblem {
             set_path(&mut doc, key, value).map_err(|m| CzError::config(format!("--set {key}"), m))?;
         }
         let edited = toml::to_string(&doc).map_err(|e| CzError::config(&shown, e.to_string()))?;
-        Self::parse(&edited, path)
+        Self::parse(&edited, path).map_err(|e| Self::blame_override(&text, overrides).unwrap_or(e))
+    }
+
+    /// The first `--set` after which `text` no longer reads as a problem file, with what is wrong
+    /// (the line numbers of the rebuilt file would mean nothing to the user).
+    fn blame_override(text: &str, overrides: &[(String, String)]) -> Option<CzError> {
+        czid_models::registry::ensure_linked();
+        let mut doc: toml::Table = toml::from_str(text).ok()?;
+        for (key, raw) in overrides {
+            let value = toml::from_str::<toml::Table>(&format!("v = {raw}")).ok()?.remove("v")?;
+            set_path(&mut doc, key, value).ok()?;
+            let edited = toml::to_string(&doc).ok()?;
+            if let Err(e) = toml::from_str::<ProblemFile>(&edited) {
+                return Some(CzError::config(format!("--set {key}={raw}"), e.message().trim_end().to_string()));
+            }
+        }
+        None
     }
 
     /// Parses problem-file text; `path` locates relative data files and names errors.

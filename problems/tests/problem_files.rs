@@ -264,6 +264,16 @@ fn overrides_replace_values_by_parameter_path() {
             LoadedProblem::read_with(&dir.join("problem.toml"), &[(key.into(), value.into())]).unwrap_err().to_string();
         assert!(e.contains(expect), "{key}: {e}");
     }
+    // A value the file cannot take is blamed on its --set, not on a line of the rebuilt file.
+    let sets = vec![
+        ("law.stiffness".to_string(), "80".to_string()),
+        ("models.patch.area".to_string(), "\"wide\"".to_string()),
+        ("models.patch.aera".to_string(), "1.0".to_string()),
+    ];
+    let e = LoadedProblem::read_with(&dir.join("problem.toml"), &sets).unwrap_err().to_string();
+    assert!(e.contains("--set models.patch.area=\"wide\"") && !e.contains("line"), "{e}");
+    let e = LoadedProblem::read_with(&dir.join("problem.toml"), &sets[2..]).unwrap_err().to_string();
+    assert!(e.contains("--set models.patch.aera=1.0") && e.contains("aera"), "{e}");
 }
 
 #[test]
