@@ -134,3 +134,15 @@ fn sigint_and_sigterm_leave_a_partial_result_and_exit_130_and_143() {
         std::fs::remove_dir_all(&out).ok();
     }
 }
+
+#[test]
+fn without_a_terminal_identify_prints_progress_lines_for_the_log() {
+    let out = scratch("progress-lines");
+    let o = czid(&["identify", "examples/hartlen-dcb/dcb01.toml", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines: Vec<String> = stderr(&o).lines().filter(|l| l.starts_with("progress: ")).map(String::from).collect();
+    // One line per tenth of the 120-evaluation budget, the last at the end of the budget.
+    assert!(lines.len() >= 5, "{lines:?}");
+    assert!(lines.last().unwrap().starts_with("progress: 120/120 evaluations"), "{lines:?}");
+    std::fs::remove_dir_all(&out).ok();
+}

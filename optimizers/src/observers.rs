@@ -25,24 +25,42 @@ impl Observer for Observers<'_> {
 /// A terminal progress bar over the evaluation budget, showing the best value.
 pub struct ProgressBar {
     bar: indicatif::ProgressBar,
+    /// Plain progress lines for a log (standard error is not a terminal, so no bar is drawn).
+    lines: Option<LogLines>,
+}
+
+/// When the next plain progress line is due.
+struct LogLines {
+    every: usize,
+    next: usize,
+    start: std::time::Instant,
 }
 
 impl ProgressBar {
-    /// A bar for a budget of `evaluations`.
+    /// A bar for a budget of `evaluations`. When standard error is not a terminal (a batch job's
+    /// log) no bar can be drawn; a plain line is printed instead at every tenth of the budget.
     pub fn new(evaluations: usize) -> Self {
+        use std::io::IsTerminal;
         let bar = indicatif::ProgressBar::new(evaluations as u64);
         if let Ok(style) =
             indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} evals  {msg}")
         {
             bar.set_style(style.progress_chars("=> "));
         }
-        ProgressBar { bar }
+        let every = evaluations.div_ceil(10).max(1);
+        let lines = (!std::io::stderr().is_terminal()).then(|| LogLines {
+            every,
+            next: every,
+            start: std::time::Instant::now(),
+        });
+        ProgressBar { bar, lines }
     }
 
-    /// A bar drawing nowhere (for tests and non-interactive runs).
+    /// A bar drawing nowhere and printing nothing (for tests and quiet runs).
     pub fn hidden(evaluations: usize) -> Self {
-        let bar = Self::new(evaluations);
+        let mut bar = Self::new(evaluations);
         bar.bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+        bar.lines = None;
         bar
     }
 
@@ -56,6 +74,19 @@ impl Observer for ProgressBar {
     fn observe(&mut self, p: &Progress<'_>) -> bool {
         self.bar.set_position(p.evaluations as u64);
         self.bar.set_message(format!("best {:.6e}  failed {}", p.best_value, p.failures));
+        if let Some(l) = &mut self.lines {
+            if p.evaluations >= l.next {
+                let total = self.bar.length().unwrap_or(0);
+                eprintln!(
+                    "progress: {}/{total} evaluations, best {:.6e}, {} failed, {:.1} s",
+                    p.evaluations,
+                    p.best_value,
+                    p.failures,
+                    l.start.elapsed().as_secs_f64()
+                );
+                l.next = (p.evaluations / l.every + 1) * l.every;
+            }
+        }
         true
     }
 }
