@@ -44,4 +44,4 @@ pub use optimizer::{
 pub use param::{Parameter, ParameterSpace, Scale};
 pub use record::{columns, Column, Record};
 pub use regimes::{GenericRegimes, RegimeRule, Span};
-pub use response::{ColumnResponse, Response};
+pub use response::{AtPeak, ColumnResponse, Response};

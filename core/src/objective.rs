@@ -104,11 +104,7 @@ impl CompositeObjective {
     pub fn term_residuals(&self, record: &Record) -> Result<Vec<Vec<f64>>> {
         self.terms
             .iter()
-            .map(|t| {
-                let sim = t.response.curve(record)?;
-                let norm = t.data.norm();
-                Ok(t.data.x().iter().zip(t.data.y()).map(|(&x, &y)| (y - sim.at(x)) / norm).collect())
-            })
+            .map(|t| scaled_residuals(t.response.as_ref(), record, t.data.x(), t.data.y(), t.data.norm()))
             .collect()
     }
 
@@ -134,6 +130,20 @@ impl CompositeObjective {
         let weights = balanced_weights(&self.evaluate(record)?.terms);
         self.set_weights(&weights)
     }
+}
+
+/// The residuals of a measurement: `(y_k − ŷ(x_k)) / scale` for each reading `(x_k, y_k)`, `ŷ` the
+/// simulated response. The one residual builder: identification scales by the data's norm
+/// (`||y||`, Eq. 17), the diagnosis by the noise σ of the measurement.
+pub fn scaled_residuals(
+    response: &dyn Response,
+    record: &Record,
+    x: &[f64],
+    y: &[f64],
+    scale: f64,
+) -> Result<Vec<f64>> {
+    let model = response.predict(record, x)?;
+    Ok(y.iter().zip(&model).map(|(y, m)| (y - m) / scale).collect())
 }
 
 /// The weights that make every term contribute equally and the objective 1, from the terms'

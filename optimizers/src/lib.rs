@@ -6,6 +6,9 @@
 //! * [`local`]: Nelder–Mead, L-BFGS and Gauss–Newton through argmin, and our
 //!   Levenberg–Marquardt, on the box through a [`transform`].
 //! * [`hybrid::Hybrid`]: a global method, then a local polish.
+//! * [`least_squares`]: the one finite-difference Jacobian and the one Levenberg–Marquardt
+//!   (unbounded or on a box, fresh or Broyden Jacobians) that identification, identifiability
+//!   and diagnosis share.
 //! * [`registry::optimizer_from_config`]: any of these by name and TOML settings.
 //! * [`observers`] (progress bar, history CSV), [`checkpoint`] (atomic state files),
 //!   [`testfns`], [`metrics`], the benchmark [`harness`], and [`plot`] (PNG/SVG line plots).
@@ -20,6 +23,7 @@ pub mod eval;
 pub mod ga;
 pub mod harness;
 pub mod hybrid;
+pub mod least_squares;
 pub mod local;
 pub mod metrics;
 pub mod miga;

@@ -9,6 +9,7 @@
 
 use crate::identification::Identification;
 use czid_core::{ParameterSpace, Result, Scale};
+use czid_optimizers::least_squares::{self, Differences, FiniteDifferences, Parallel};
 use nalgebra::DMatrix;
 
 /// Step of the central differences, in unit-cube coordinates: 1 % of each range, wide enough
@@ -82,7 +83,10 @@ pub const FD_STEP: f64 = STEP;
 pub fn assess(id: &Identification, u: &[f64]) -> Result<Assessment> {
     let residuals = |w: &[f64]| -> Result<Vec<f64>> { Ok(id.simulate(&id.space().from_unit(w))?.evaluation.residuals) };
     let r0 = residuals(u)?;
-    let jac = crate::diagnose::lsq::jacobian(&residuals, u, STEP)?;
+    let fd = FiniteDifferences { step: STEP, scheme: Differences::Central };
+    let cube = vec![(0.0, 1.0); u.len()];
+    let columns: Vec<usize> = (0..u.len()).collect();
+    let jac = least_squares::jacobian(&Parallel(residuals), u, None, &fd, Some(&cube), &columns)?;
     Ok(assess_jacobian(id.space(), u, &r0, &jac))
 }
 

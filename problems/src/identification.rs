@@ -81,6 +81,12 @@ impl Term {
             Term::DebondedLength => columns::DEBONDED_LENGTH,
         }
     }
+
+    /// The simulated response compared with it: its column against the displacement (the same
+    /// for identification and diagnosis).
+    pub fn response(self) -> ColumnResponse {
+        ColumnResponse::new(columns::DISPLACEMENT, self.column())
+    }
 }
 
 impl std::fmt::Display for Term {
@@ -178,7 +184,7 @@ impl Identification {
             }
             let mut terms = vec![ObjectiveTerm {
                 name: format!("F:{}", e.name),
-                response: Box::new(ColumnResponse::new(columns::DISPLACEMENT, columns::LOAD)),
+                response: Box::new(Term::Load.response()),
                 data: e.load.clone(),
                 weight: 1.0,
             }];
@@ -187,7 +193,7 @@ impl Identification {
                 if l.norm() > 0.0 {
                     terms.push(ObjectiveTerm {
                         name: format!("L:{}", e.name),
-                        response: Box::new(ColumnResponse::new(columns::DISPLACEMENT, columns::DEBONDED_LENGTH)),
+                        response: Box::new(Term::DebondedLength.response()),
                         data: l.clone(),
                         weight: 1.0,
                     });

@@ -1,7 +1,8 @@
 //! Gauss–Newton (argmin's `GaussNewton`) on finite-difference Jacobians of
 //! [`czid_core::Evaluation::residuals`].
 
-use super::{local_optimizer, Ctx, Differences, LocalSettings};
+use super::{local_optimizer, Ctx, LocalSettings};
+use crate::least_squares::{self, FiniteDifferences, ResidualSource};
 use argmin::core::{Error, Executor, Jacobian, Operator};
 use argmin_math::{ArgminDot, ArgminInv, ArgminTranspose};
 use std::cell::RefCell;
@@ -28,11 +29,6 @@ impl Mat {
     pub fn new(rows: usize, cols: usize, data: Vec<f64>) -> Self {
         debug_assert_eq!(data.len(), rows * cols);
         Mat { rows, cols, data }
-    }
-
-    /// The row-major entries.
-    pub fn into_data(self) -> Vec<f64> {
-        self.data
     }
 
     fn at(&self, r: usize, c: usize) -> f64 {
@@ -124,10 +120,24 @@ pub(crate) struct Residuals<'c, 'a> {
 }
 
 impl Residuals<'_, '_> {
-    /// Residuals at each point; an error if any evaluation failed or has no residuals.
-    pub fn batch(&self, zs: &[Vec<f64>]) -> std::result::Result<Vec<Vec<f64>>, Error> {
-        let evals = self.ctx.eval(zs)?;
-        evals
+    /// Jacobian `∂r/∂z` (rows: residuals) given `r(z)` when known.
+    pub fn jacobian_at(&self, z: &[f64], r0: Option<&[f64]>) -> std::result::Result<Mat, Error> {
+        let s = self.ctx.settings;
+        let fd = FiniteDifferences { step: s.fd_step, scheme: s.differences };
+        let columns: Vec<usize> = (0..z.len()).collect();
+        let j = least_squares::jacobian(self, z, r0, &fd, None, &columns)?;
+        Ok(Mat::new(j.nrows(), j.ncols(), j.transpose().as_slice().to_vec()))
+    }
+}
+
+/// Evaluations through the run's budget and tracker; a failed point (no residuals) is an error.
+impl ResidualSource for Residuals<'_, '_> {
+    type Error = Error;
+
+    fn residuals(&self, zs: &[Vec<f64>]) -> std::result::Result<Vec<std::result::Result<Vec<f64>, Error>>, Error> {
+        Ok(self
+            .ctx
+            .eval(zs)?
             .into_iter()
             .map(|e| {
                 if e.residuals.is_empty() {
@@ -136,31 +146,7 @@ impl Residuals<'_, '_> {
                     Ok(e.residuals)
                 }
             })
-            .collect()
-    }
-
-    /// Jacobian `∂r/∂z` (rows: residuals) given `r(z)` when known.
-    pub fn jacobian_at(&self, z: &[f64], r0: Option<&[f64]>) -> std::result::Result<Mat, Error> {
-        let (pts, h) = self.ctx.fd_points(z);
-        let rs = self.batch(&pts)?;
-        let n = z.len();
-        let m = rs[0].len();
-        let central = self.ctx.settings.differences == Differences::Central;
-        let base = match (central, r0) {
-            (true, _) => None,
-            (false, Some(r)) => Some(r.to_vec()),
-            (false, None) => Some(self.batch(&[z.to_vec()])?.remove(0)),
-        };
-        let mut data = vec![0.0; m * n];
-        for i in 0..n {
-            for k in 0..m {
-                data[k * n + i] = match &base {
-                    None => (rs[2 * i][k] - rs[2 * i + 1][k]) / (2.0 * h[i]),
-                    Some(r) => (rs[i][k] - r[k]) / h[i],
-                };
-            }
-        }
-        Ok(Mat::new(m, n, data))
+            .collect())
     }
 }
 
@@ -169,7 +155,7 @@ impl Operator for Residuals<'_, '_> {
     type Output = Vec<f64>;
 
     fn apply(&self, z: &Vec<f64>) -> std::result::Result<Vec<f64>, Error> {
-        let r = self.batch(std::slice::from_ref(z))?.remove(0);
+        let r = self.residuals_at(z)?;
         *self.last.borrow_mut() = Some((z.clone(), r.clone()));
         Ok(r)
     }

@@ -1,5 +1,6 @@
 //! Local methods on the box through a [`BoundTransform`]: Nelder–Mead, L-BFGS and
-//! Gauss–Newton from argmin (given plain `Vec<f64>`), and our Levenberg–Marquardt.
+//! Gauss–Newton from argmin (given plain `Vec<f64>`), and the shared Levenberg–Marquardt of
+//! [`crate::least_squares`].
 //!
 //! They search `z ∈ Rⁿ` with `x = T(z)`; derivatives are finite differences in `z`, their
 //! `2n` (central) or `n` (forward) points evaluated as one parallel batch. They draw no
@@ -23,16 +24,7 @@ use czid_core::{Budget, CzError, Evaluation, Observer, OptimizationResult, Optim
 use serde::{Deserialize, Serialize};
 use std::cell::RefCell;
 
-/// Finite-difference scheme for gradients and Jacobians.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Differences {
-    /// `(f(z + h) − f(z − h)) / 2h`: `2n` evaluations, error `O(h²)`.
-    #[default]
-    Central,
-    /// `(f(z + h) − f(z)) / h`: `n` evaluations, error `O(h)`.
-    Forward,
-}
+pub use crate::least_squares::Differences;
 
 /// Settings shared by the local methods.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -12,11 +12,12 @@ pub use family::{Family, TestDraw};
 
 use crate::data::Experiment;
 use crate::diagnose::candidate::{CandidateEffect, Library};
-use crate::diagnose::run::{diagnose_subject, Options, Subject};
+use crate::diagnose::run::{diagnose_subject, Diagnosis, Options, Subject};
 use crate::diagnose::stats::chi2_survival;
+use crate::identification::Setup;
 use crate::output::OutputDir;
 use crate::synthetic::{synthesize, Noise};
-use czid_core::{columns, Curve, CzError, Result};
+use czid_core::{columns, Curve, CzError, Record, Result};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -155,25 +156,7 @@ fn case(
     };
     let mut run = || -> Result<()> {
         let base = family.base_setup(&truth, end)?;
-        // A planted model that stops early is drawn again (a few times), and counted.
-        let mut attempt = 0;
-        let record = loop {
-            let true_setup = match effect {
-                None => base.duplicate()?,
-                Some(c) => c.apply(&base, &size)?,
-            };
-            match true_setup.models[family.name()].simulate(true_setup.law.as_ref()) {
-                Ok(r) => break r,
-                Err(f) if attempt < 5 && planted != NONE => {
-                    attempt += 1;
-                    out.redraws = attempt;
-                    size = effect.and_then(|c| c.plant(&mut rng)).unwrap_or_default();
-                    out.size = size.clone();
-                    let _ = f;
-                }
-                Err(f) => return Err(CzError::Simulation(format!("planted model: {f}"))),
-            }
-        };
+        let record = planted_record(&base, planted, effect, family, &mut size, &mut rng, &mut out)?;
         // Without a set end the test is read up to a share of the deflection at its peak load.
         let end = match end {
             Some(e) => e,
@@ -184,19 +167,8 @@ fn case(
             }
         };
         out.end = end;
-        let data = synthesize(
-            &record,
-            readings,
-            Some(end),
-            &Noise { load_sd: noise[0], length_sd: noise[1], seed: noise_seed },
-        )?;
-        let experiment = Experiment {
-            name: family.name().into(),
-            load: Curve::new(data.displacement.clone(), data.load)?,
-            debonded_length: Some(Curve::new(data.displacement, data.debonded_length)?),
-            initial_crack: None,
-            dropped: Default::default(),
-        };
+        let noise = Noise { load_sd: noise[0], length_sd: noise[1], seed: noise_seed };
+        let experiment = synthetic_experiment(family, &record, readings, end, &noise)?;
         let space = family.space();
         let u0: Vec<f64> =
             space.to_unit(&truth[..space.dim()]).iter().zip(&jitter).map(|(u, j)| (u + j).clamp(0.0, 1.0)).collect();
@@ -214,26 +186,7 @@ fn case(
             ..Options::default()
         };
         let d = diagnose_subject(&subject, &u0, library, &opts)?;
-        out.base_reduced_chi2 = d.base.reduced_chi2;
-        out.base_at_noise_level = d.base.at_noise_level;
-        out.ranking = d
-            .candidates
-            .iter()
-            .filter_map(|c| c.score.as_ref().map(|s| (c.name.clone(), s.statistic, s.significant)))
-            .collect();
-        if let Some((name, _, true)) = out.ranking.first() {
-            out.diagnosed = name.clone();
-        }
-        if let Some(c) = d.candidates.iter().find(|c| c.name == planted) {
-            if let Some(r) = &c.refit {
-                out.true_refit = r.effect.iter().map(|v| v.value).collect();
-                let dof = d.readings.saturating_sub(r.parameters.len() + r.effect.len()).max(1) as f64;
-                out.true_reduced_chi2 = Some(r.chi2 / dof);
-                out.true_at_noise_level = Some(chi2_survival(r.chi2, dof) > 1e-3);
-            }
-        }
-        out.notes = d.candidates.iter().filter_map(|c| c.error.as_ref().map(|e| format!("{}: {e}", c.name))).collect();
-        out.pairs = d.pairs.iter().map(|p| (p.a.clone(), p.b.clone(), p.cos)).collect();
+        record_diagnosis(&mut out, &d, planted);
         Ok(())
     };
     if let Err(e) = run() {
@@ -241,6 +194,79 @@ fn case(
     }
     out.seconds = clock.elapsed().as_secs_f64();
     out
+}
+
+/// The planted model's record; a planted model that stops early is drawn again (a few times),
+/// and the redraws counted in `out`.
+fn planted_record(
+    base: &Setup,
+    planted: &str,
+    effect: Option<&dyn CandidateEffect>,
+    family: Family,
+    size: &mut Vec<f64>,
+    rng: &mut ChaCha8Rng,
+    out: &mut CaseResult,
+) -> Result<Record> {
+    let mut attempt = 0;
+    loop {
+        let true_setup = match effect {
+            None => base.duplicate()?,
+            Some(c) => c.apply(base, size)?,
+        };
+        match true_setup.models[family.name()].simulate(true_setup.law.as_ref()) {
+            Ok(r) => return Ok(r),
+            Err(_) if attempt < 5 && planted != NONE => {
+                attempt += 1;
+                out.redraws = attempt;
+                *size = effect.and_then(|c| c.plant(rng)).unwrap_or_default();
+                out.size = size.clone();
+            }
+            Err(f) => return Err(CzError::Simulation(format!("planted model: {f}"))),
+        }
+    }
+}
+
+/// The synthetic test read off a planted record up to `end` (mm), with noise.
+fn synthetic_experiment(
+    family: Family,
+    record: &Record,
+    readings: usize,
+    end: f64,
+    noise: &Noise,
+) -> Result<Experiment> {
+    let data = synthesize(record, readings, Some(end), noise)?;
+    Ok(Experiment {
+        name: family.name().into(),
+        load: Curve::new(data.displacement.clone(), data.load)?,
+        debonded_length: Some(Curve::new(data.displacement, data.debonded_length)?),
+        initial_crack: None,
+        dropped: Default::default(),
+    })
+}
+
+/// What a case keeps of its diagnosis: the base fit, the ranking and named cause, the true
+/// effect's refit, failures and the candidates' angles.
+fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
+    out.base_reduced_chi2 = d.base.reduced_chi2;
+    out.base_at_noise_level = d.base.at_noise_level;
+    out.ranking = d
+        .candidates
+        .iter()
+        .filter_map(|c| c.score.as_ref().map(|s| (c.name.clone(), s.statistic, s.significant)))
+        .collect();
+    if let Some((name, _, true)) = out.ranking.first() {
+        out.diagnosed = name.clone();
+    }
+    if let Some(c) = d.candidates.iter().find(|c| c.name == planted) {
+        if let Some(r) = &c.refit {
+            out.true_refit = r.effect.iter().map(|v| v.value).collect();
+            let dof = d.readings.saturating_sub(r.parameters.len() + r.effect.len()).max(1) as f64;
+            out.true_reduced_chi2 = Some(r.chi2 / dof);
+            out.true_at_noise_level = Some(chi2_survival(r.chi2, dof) > 1e-3);
+        }
+    }
+    out.notes = d.candidates.iter().filter_map(|c| c.error.as_ref().map(|e| format!("{}: {e}", c.name))).collect();
+    out.pairs = d.pairs.iter().map(|p| (p.a.clone(), p.b.clone(), p.cos)).collect();
 }
 
 /// Where a finished case is kept: its file name in the store (family, seed, index and planted
@@ -327,6 +353,12 @@ pub fn run(
         })
         .collect();
 
+    Ok(summarise(effects, cases, clock.elapsed().as_secs_f64()))
+}
+
+/// The scores of finished cases: confusion matrix, top-1/top-2 per effect, false alarms, the
+/// effects' mean angles and which pairs are confusable.
+fn summarise(effects: Vec<String>, cases: Vec<CaseResult>, wall_seconds: f64) -> BenchReport {
     let mut labels = effects.clone();
     labels.push(NONE.into());
     let at = |l: &str| labels.iter().position(|x| x == l).unwrap_or(labels.len() - 1);
@@ -364,7 +396,7 @@ pub fn run(
     let planted: Vec<&CaseResult> = cases.iter().filter(|c| c.planted != NONE).collect();
     let true_effect_at_noise_level =
         planted.iter().filter(|c| c.true_at_noise_level == Some(true)).count() as f64 / planted.len().max(1) as f64;
-    Ok(BenchReport {
+    BenchReport {
         labels,
         confusion,
         top1,
@@ -376,8 +408,8 @@ pub fn run(
         top1_separable,
         true_effect_at_noise_level,
         cases,
-        wall_seconds: clock.elapsed().as_secs_f64(),
-    })
+        wall_seconds,
+    }
 }
 
 /// The report in Markdown.

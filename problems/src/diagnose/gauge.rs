@@ -5,7 +5,8 @@
 use crate::data::Experiment;
 use crate::identification::{simulate_experiments, Runs, Setup, Term};
 use czid_core::noise;
-use czid_core::{columns, CzError, Record, Result};
+use czid_core::objective::scaled_residuals;
+use czid_core::{CzError, Record, Response, Result};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -150,8 +151,7 @@ impl Gauge {
 
     /// Model value of a block's response at its readings.
     pub fn model_values(block: &Block, record: &Record) -> Result<Vec<f64>> {
-        let curve = record.curve(columns::DISPLACEMENT, block.term.column())?;
-        Ok(curve.sample(&block.x))
+        block.term.response().predict(record, &block.x)
     }
 
     /// The experiments the gauge measures, in block order (each once).
@@ -168,8 +168,7 @@ impl Gauge {
             let record = records
                 .get(&b.experiment)
                 .ok_or_else(|| CzError::config(format!("experiment `{}`", b.experiment), "has no simulation record"))?;
-            let model = Self::model_values(b, record)?;
-            r.extend(b.y.iter().zip(&model).map(|(y, m)| (y - m) / b.sigma));
+            r.extend(scaled_residuals(&b.term.response(), record, &b.x, &b.y, b.sigma)?);
         }
         Ok(r)
     }

@@ -7,7 +7,6 @@
 //! * [`regimes`]: the test split into regimes from its load curve; misfit and sign per regime.
 //! * [`candidate`]: the [`CandidateEffect`] plug-in trait and the bundled [`Library`].
 //! * [`score`]: score statistics at the base fit, confounding, absorbing parameter.
-//! * [`lsq`]: bounded Levenberg–Marquardt for the base polish and the refits.
 //! * [`run`]: the whole diagnosis ([`run::diagnose`]), its outline calling the [`stages`] in
 //!   turn, and its report ([`report`]).
 //! * [`bench`]: planted-effect cases with a known answer.
@@ -15,7 +14,6 @@
 pub mod bench;
 pub mod candidate;
 pub mod gauge;
-pub mod lsq;
 pub mod regimes;
 pub mod report;
 pub mod run;

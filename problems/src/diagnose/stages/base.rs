@@ -2,13 +2,17 @@
 //! the noise, and what the data say about each parameter.
 
 use crate::diagnose::gauge::{Gauge, Misfit};
-use crate::diagnose::lsq::{self, LsOptions};
 use crate::diagnose::run::{FittedParameter, Identifiability, Subject};
 use crate::diagnose::score::Linearisation;
 use crate::diagnose::stats::chi2_survival;
 use crate::identifiability::{assess_jacobian, FD_STEP};
 use crate::identification::Setup;
 use czid_core::{ParameterSpace, Result};
+use czid_optimizers::least_squares::{self, Differences, FiniteDifferences, LmOptions, Parallel};
+
+/// Finite-difference step of the polish's Jacobians in unit-cube coordinates (wider than the
+/// forward models' parameter ripple).
+pub const POLISH_STEP: f64 = 2e-3;
 
 /// The fitted base model and what the later stages need of it.
 pub struct Base {
@@ -54,10 +58,11 @@ pub fn fit(subject: &Subject, u0: &[f64], gauge: Gauge) -> Result<Base> {
     let space = subject.space.clone();
     let setup = subject.setup.duplicate()?;
     let polish = {
-        let f = |u: &[f64]| Ok(Misfit::of(&gauge, &space.apply(&setup, &space.from_unit(u))?)?.r);
-        lsq::minimize(&f, u0, &[], &LsOptions::default())?
+        let f =
+            |u: &[f64]| -> Result<Vec<f64>> { Ok(Misfit::of(&gauge, &space.apply(&setup, &space.from_unit(u))?)?.r) };
+        least_squares::minimize(&Parallel(f), u0, &LmOptions::unit_cube(space.dim(), POLISH_STEP), None)?
     };
-    let u = polish.u;
+    let u = polish.z;
     let x = space.from_unit(&u);
     let fitted = space.apply(&setup, &x)?;
     let misfit = Misfit::of(&gauge, &fitted)?;
@@ -71,7 +76,11 @@ pub fn fit(subject: &Subject, u0: &[f64], gauge: Gauge) -> Result<Base> {
 /// the Jacobian's singular values and correlations, and the linearisation the scores use.
 pub fn assess(base: &Base) -> Result<(Vec<FittedParameter>, Identifiability, Linearisation)> {
     let (space, p) = (&base.space, base.space.dim());
-    let jac = lsq::jacobian(&base.residuals(&base.gauge), &base.u, FD_STEP)?;
+    let fd = FiniteDifferences { step: FD_STEP, scheme: Differences::Central };
+    let cube = vec![(0.0, 1.0); p];
+    let columns: Vec<usize> = (0..p).collect();
+    let jac =
+        least_squares::jacobian(&Parallel(base.residuals(&base.gauge)), &base.u, None, &fd, Some(&cube), &columns)?;
     let assessment = assess_jacobian(space, &base.u, &base.misfit.r, &jac);
     let parameters = space
         .parameters()

@@ -1,27 +1,42 @@
 //! How far: a candidate switched on and refitted with the fitted parameters, its realised
 //! shrinkage of the misfit (overall and per regime) and its information criteria.
 
-use super::base::{aic_bic, Base};
+use super::base::{aic_bic, Base, POLISH_STEP};
 use super::ranking::Ranked;
 use crate::diagnose::candidate::CandidateEffect;
 use crate::diagnose::gauge::{Gauge, Misfit};
-use crate::diagnose::lsq::{self, LsOptions};
 use crate::diagnose::regimes::{self, Regime};
 use crate::diagnose::run::{Refit, RegimeShrinkage, Value};
 use crate::diagnose::score::{Linearisation, Score, Sensitivity};
 use czid_core::{Parameter, Result};
+use czid_optimizers::least_squares::{self, JacobianUpdates, LmOptions, Parallel};
 use nalgebra::DMatrix;
 
 /// Refits start from the sensitivities of the scores and follow them with Broyden updates: one
-/// run per step (a large-rotation run costs ~50 small-rotation ones), one fresh finite-difference
-/// Jacobian if they stall.
-pub const REFIT: LsOptions = LsOptions { max_iterations: 40, step: 2e-3, tolerance: 1e-6, fd_jacobians: 3 };
+/// run per step (a large-rotation run costs ~50 small-rotation ones), up to three fresh
+/// finite-difference Jacobians if they stall.
+pub fn refit_options(dim: usize) -> LmOptions {
+    LmOptions {
+        max_iterations: 80,
+        updates: JacobianUpdates::Broyden { fresh: 3 },
+        ..LmOptions::unit_cube(dim, POLISH_STEP)
+    }
+}
 /// Unit-cube values from which the secondary parameters of a several-parameter effect are refitted
 /// again.
 const SECONDARY_STARTS: [f64; 3] = [0.1, 0.3, 0.6];
 /// A switched-on effect only moves the fitted parameters, whose Jacobian barely changes with it;
-/// its runs can be far dearer (large rotations), so fewer iterations and one fresh Jacobian.
-const REFIT_SWITCH: LsOptions = LsOptions { max_iterations: 8, step: 2e-3, tolerance: 1e-4, fd_jacobians: 1 };
+/// its runs can be far dearer (large rotations), so fewer steps, a looser stop and one fresh
+/// Jacobian; the switch itself stays on.
+fn switch_options(dim: usize, switches: std::ops::Range<usize>) -> LmOptions {
+    LmOptions {
+        max_iterations: 16,
+        min_decrease: 1e-4,
+        updates: JacobianUpdates::Broyden { fresh: 1 },
+        fixed: switches.collect(),
+        ..LmOptions::unit_cube(dim, POLISH_STEP)
+    }
+}
 
 /// A candidate's extended model on `gauge`: fitted parameters then the effect's, unit-cube
 /// coordinates.
@@ -61,13 +76,15 @@ pub fn refit_on(
     jacobian: Option<DMatrix<f64>>,
 ) -> Result<RefitOutcome> {
     let model = extended(gauge, base, c, params);
-    let f = |v: &[f64]| Ok(model(v)?.r);
-    // A switch stays on; only the fitted parameters move.
-    let fixed: Vec<usize> = if c.discrete() { (base.space.dim()..start.len()).collect() } else { Vec::new() };
-    let opts = if c.discrete() { &REFIT_SWITCH } else { &REFIT };
-    let res = lsq::minimize_from(&f, start, &fixed, opts, jacobian)?;
-    let misfit = model(&res.u)?;
-    Ok(RefitOutcome { v: res.u, misfit, evaluations: res.evaluations, jacobian: res.jacobian })
+    let f = |v: &[f64]| -> Result<Vec<f64>> { Ok(model(v)?.r) };
+    let opts = if c.discrete() {
+        switch_options(start.len(), base.space.dim()..start.len())
+    } else {
+        refit_options(start.len())
+    };
+    let res = least_squares::minimize(&Parallel(f), start, &opts, jacobian)?;
+    let misfit = model(&res.z)?;
+    Ok(RefitOutcome { v: res.z, misfit, evaluations: res.evaluations, jacobian: res.jacobian })
 }
 
 /// Where a refit starts: the joint first-order prediction (the effect at the size the data ask

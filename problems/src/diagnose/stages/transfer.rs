@@ -7,16 +7,16 @@
 //!   and the effect when it carries over.
 
 use super::base::Base;
-use super::refit::{extended, refit_on, RefitOutcome, REFIT};
+use super::refit::{extended, refit_on, refit_options, RefitOutcome};
 use crate::diagnose::candidate::CandidateEffect;
 use crate::diagnose::gauge::{Gauge, Misfit};
-use crate::diagnose::lsq;
 use crate::diagnose::regimes::{self, Regime};
 use crate::diagnose::run::Transfer;
 use crate::diagnose::score::Linearisation;
 use crate::identification::{Setup, Term};
 use crate::problem_file::LoadedProblem;
 use czid_core::{Parameter, ParameterSpace, Result};
+use czid_optimizers::least_squares::{self, Parallel};
 use nalgebra::DMatrix;
 use std::collections::BTreeMap;
 
@@ -75,14 +75,13 @@ impl Holdout {
             return Ok(None);
         }
         say(&format!("base fit without the {label} (held out)"));
-        let fit = lsq::minimize_from(
-            &base.residuals(&early),
+        let fit = least_squares::minimize(
+            &Parallel(base.residuals(&early)),
             &base.u,
-            &[],
-            &REFIT,
+            &refit_options(base.u.len()),
             Some(select_rows(&lin.jac, &early_rows)),
         )?;
-        let base_chi2 = Misfit::of(&late, &base.space.apply(&base.setup, &base.space.from_unit(&fit.u))?)?.rss();
+        let base_chi2 = Misfit::of(&late, &base.space.apply(&base.setup, &base.space.from_unit(&fit.z))?)?.rss();
         Ok(Some(Holdout { label, early, early_rows, late, base_chi2 }))
     }
 
