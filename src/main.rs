@@ -59,6 +59,10 @@ enum Command {
         /// Continue an interrupted run from the checkpoint in the output folder.
         #[arg(long)]
         resume: bool,
+        /// Abort the process once this many evaluations are done, as a kill would (for tests of
+        /// interruption and resume).
+        #[arg(long, hide = true)]
+        abort_after_evaluations: Option<usize>,
     },
     /// Make a synthetic test (CSV) from a truth file: a law, a model and a noise description.
     Synthesize {
@@ -130,8 +134,16 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Demo { out } => demo(&out),
         Command::Simulate { problem, out, set } => run_simulate(&problem, &set.sets, &out),
-        Command::Identify { problem, out, set, optimizer, seed, budget, resume } => {
-            let opts = RunOptions { optimizer, seed, budget, progress: true, resume, stop: Some(interrupt_flag()) };
+        Command::Identify { problem, out, set, optimizer, seed, budget, resume, abort_after_evaluations } => {
+            let opts = RunOptions {
+                optimizer,
+                seed,
+                budget,
+                progress: true,
+                resume,
+                stop: Some(interrupt_flag()),
+                abort_after: abort_after_evaluations,
+            };
             run_identify(&problem, &set.sets, &out, &opts)
         }
         Command::Harness(args) => commands::harness::run(&args),
@@ -209,6 +221,9 @@ fn run_identify(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: 
     let problem = read_problem(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, opts.resume)?;
     let res = identify(&problem, opts, &dir)?;
+    if res.resumed > 0 {
+        println!("resumed an interrupted run (resumed {} time(s); wall time counts every part)", res.resumed);
+    }
     if res.partial {
         println!("interrupted: best so far in {}; continue with --resume", dir.file("result.partial.json").display());
     }

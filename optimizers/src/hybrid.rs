@@ -95,21 +95,58 @@ impl Observer for Offset<'_> {
     }
 }
 
-impl Optimizer for Hybrid {
-    fn name(&self) -> &str {
-        "hybrid"
+/// The checkpoint of a hybrid run: the global method's own state while it runs, then the global
+/// phase's result once the local polish has started (the polish keeps no state: a run resumed
+/// in that phase polishes again from the same point, which gives the same result).
+#[derive(Serialize, Deserialize)]
+#[serde(tag = "phase", rename_all = "snake_case")]
+enum Phase {
+    Global { state: serde_json::Value },
+    Local { global: OptimizationResult },
+}
+
+impl Snapshot for Phase {
+    fn to_json(&self) -> Result<String> {
+        serde_json::to_string(self).map_err(|e| CzError::Optimizer(format!("hybrid checkpoint: {e}")))
+    }
+}
+
+/// Wraps the global method's checkpoints as [`Phase::Global`], and notes whether an observer
+/// stopped the run (then there is no polish: the run resumes in the global phase).
+struct GlobalPhase<'a> {
+    inner: &'a mut dyn Observer,
+    stopped: bool,
+}
+
+impl Observer for GlobalPhase<'_> {
+    fn observe(&mut self, p: &Progress<'_>) -> bool {
+        let go_on = self.inner.observe(p);
+        self.stopped |= !go_on;
+        go_on
     }
 
-    fn minimize(
+    fn checkpoint(&mut self, p: &Progress<'_>, state: &dyn Snapshot) -> Result<()> {
+        let state = serde_json::from_str(&state.to_json()?)
+            .map_err(|e| CzError::Optimizer(format!("hybrid checkpoint of the global phase: {e}")))?;
+        self.inner.checkpoint(p, &Phase::Global { state })
+    }
+}
+
+impl Hybrid {
+    /// The budgets of the two phases.
+    fn split(&self, budget: &Budget) -> Budget {
+        let local_budget = (self.local_fraction * budget.evaluations as f64).floor() as usize;
+        Budget { evaluations: budget.evaluations - local_budget, target: budget.target }
+    }
+
+    /// The local polish from the global phase's result `g`, and the two merged.
+    fn polish(
         &self,
         problem: &dyn Problem,
         budget: &Budget,
-        seed: u64,
+        mut g: OptimizationResult,
         observer: &mut dyn Observer,
     ) -> Result<OptimizationResult> {
-        let local_budget = (self.local_fraction * budget.evaluations as f64).floor() as usize;
-        let global_budget = Budget { evaluations: budget.evaluations - local_budget, target: budget.target };
-        let mut g = self.global.minimize(problem, &global_budget, seed, observer)?;
         let remaining = budget.evaluations - g.evaluations;
         if remaining == 0 || budget.target.is_some_and(|t| g.best.value <= t) || g.best_x.iter().any(|v| !v.is_finite())
         {
@@ -117,6 +154,14 @@ impl Optimizer for Hybrid {
         }
         let mut offset =
             Offset { inner: observer, evaluations: g.evaluations, failures: g.failures, iterations: g.history.len() };
+        let start = Progress {
+            iteration: g.history.len(),
+            evaluations: g.evaluations,
+            failures: g.failures,
+            best_value: g.best.value,
+            best_x: &g.best_x,
+        };
+        offset.inner.checkpoint(&start, &Phase::Local { global: g.clone() })?;
         let local = self.local.minimize_from(
             problem,
             &Budget { evaluations: remaining, target: budget.target },
@@ -145,5 +190,49 @@ impl Optimizer for Hybrid {
         g.evaluations = total;
         g.failures += local.failures;
         Ok(g)
+    }
+}
+
+impl Optimizer for Hybrid {
+    fn name(&self) -> &str {
+        "hybrid"
+    }
+
+    fn minimize(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        seed: u64,
+        observer: &mut dyn Observer,
+    ) -> Result<OptimizationResult> {
+        let mut phase = GlobalPhase { inner: observer, stopped: false };
+        let g = self.global.minimize(problem, &self.split(budget), seed, &mut phase)?;
+        if phase.stopped {
+            return Ok(g);
+        }
+        self.polish(problem, budget, g, observer)
+    }
+
+    fn resume(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        state: &str,
+        observer: &mut dyn Observer,
+    ) -> Result<OptimizationResult> {
+        let phase: Phase = serde_json::from_str(state)
+            .map_err(|e| CzError::Optimizer(format!("the checkpoint is not a hybrid run's: {e}")))?;
+        let g = match phase {
+            Phase::Global { state } => {
+                let mut phase = GlobalPhase { inner: observer, stopped: false };
+                let g = self.global.resume(problem, &self.split(budget), &state.to_string(), &mut phase)?;
+                if phase.stopped {
+                    return Ok(g);
+                }
+                g
+            }
+            Phase::Local { global } => global,
+        };
+        self.polish(problem, budget, g, observer)
     }
 }

@@ -23,6 +23,7 @@ pub mod eval;
 pub mod ga;
 pub mod harness;
 pub mod hybrid;
+pub mod journal;
 pub mod least_squares;
 pub mod local;
 pub mod metrics;

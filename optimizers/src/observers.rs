@@ -64,9 +64,15 @@ impl ProgressBar {
         bar
     }
 
-    /// Clears the bar.
+    /// Ends the bar where the run ended: at the evaluations observed last, which a run that
+    /// converged or was stopped leaves short of the budget (the bar does not jump to the end).
     pub fn finish(&self) {
-        self.bar.finish();
+        self.bar.abandon();
+    }
+
+    /// Evaluations the bar shows.
+    pub fn position(&self) -> usize {
+        self.bar.position() as usize
     }
 }
 
@@ -135,7 +141,8 @@ impl Observer for CsvHistory {
         if self.error.is_some() {
             return false;
         }
-        if let Err(e) = self.write(p) {
+        // Each row reaches the file at once, so a killed run keeps every row it wrote.
+        if let Err(e) = self.write(p).and_then(|_| self.writer.flush().map_err(csv::Error::from)) {
             self.error = Some(CzError::Io { path: self.path.clone(), message: e.to_string() });
             return false;
         }

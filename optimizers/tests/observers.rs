@@ -24,3 +24,20 @@ fn history_csv_has_a_row_per_generation() {
     assert!(lines[6].starts_with(&format!("5,{},0,{}", r.evaluations, r.best.value)));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_progress_bar_ends_where_the_run_ended_not_at_the_budget() {
+    // Levenberg–Marquardt on Rosenbrock converges long before a budget of 400.
+    let problem = by_name("rosenbrock2").unwrap();
+    let lm = czid_optimizers::LevenbergMarquardt::new(czid_optimizers::LocalSettings {
+        tolerance: 1e-10,
+        restarts: 0,
+        ..Default::default()
+    })
+    .unwrap();
+    let mut bar = ProgressBar::hidden(400);
+    let r = lm.minimize(problem.as_ref(), &Budget::evaluations(400), 0, &mut bar).unwrap();
+    bar.finish();
+    assert!(r.evaluations < 400, "{}", r.evaluations);
+    assert_eq!(bar.position(), r.evaluations);
+}

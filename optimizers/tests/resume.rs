@@ -53,6 +53,33 @@ fn nsga2_resumes_exactly() {
 }
 
 #[test]
+fn hybrid_resumes_exactly_in_either_phase() {
+    let p = Flaky::rastrigin(4);
+    let settings: toml::Value = toml::from_str(
+        "global = { type = \"miga\" }\nlocal = { type = \"levenberg-marquardt\" }\nlocal_fraction = 0.3",
+    )
+    .unwrap();
+    let hybrid = optimizer_from_config("hybrid", &settings).unwrap();
+    let budget = Budget::evaluations(2000);
+    let full = hybrid.minimize(&p, &budget, 3, &mut NoObserver).unwrap();
+    // The global phase (MIGA, 1400 evaluations) has 14 generations: stopped in it, then in the
+    // polish.
+    for stop_at in [6, 17] {
+        let path = temp(&format!("hybrid-{stop_at}"));
+        let mut writer = CheckpointWriter::new(&path, 1).unwrap();
+        let mut stop = StopAt(stop_at);
+        let partial = hybrid.minimize(&p, &budget, 3, &mut Observers(vec![&mut writer, &mut stop])).unwrap();
+        assert!(partial.evaluations < full.evaluations, "stopped at {stop_at}");
+        let state = std::fs::read_to_string(&path).unwrap();
+        let phase = if stop_at < 14 { "\"phase\":\"global\"" } else { "\"phase\":\"local\"" };
+        assert!(state.contains(phase), "stopped at {stop_at}: {}", &state[..60.min(state.len())]);
+        let resumed = resume_from_file(hybrid.as_ref(), &p, &budget, &path, &mut NoObserver).unwrap();
+        assert_eq!(resumed, full, "hybrid stopped at iteration {stop_at}");
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    }
+}
+
+#[test]
 fn resume_rejects_foreign_state() {
     let p = Flaky::rastrigin(5);
     let empty = toml::Value::Table(Default::default());

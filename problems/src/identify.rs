@@ -6,8 +6,10 @@ use crate::identification::{Identification, Outcome};
 use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
 use crate::problem_file::LoadedProblem;
+use crate::resume::{earlier_rows, Fingerprint, RunClock, RunFile};
 use czid_core::{columns, Budget, CzError, Evaluation, Observer, OptimizationResult, Problem, Progress, Result};
 use czid_optimizers::checkpoint::CheckpointWriter;
+use czid_optimizers::journal::Journal;
 use czid_optimizers::observers::{CsvHistory, Observers, ProgressBar};
 use czid_optimizers::registry::{method_from_config, Method};
 use serde::Serialize;
@@ -32,6 +34,9 @@ pub struct RunOptions {
     pub resume: bool,
     /// Set to true (e.g. by Ctrl-C) to stop after the current iteration, leaving a checkpoint.
     pub stop: Option<Arc<AtomicBool>>,
+    /// Abort the process, as a `SIGKILL` would, once this many evaluations are done (for tests
+    /// of what an interruption leaves behind).
+    pub abort_after: Option<usize>,
 }
 
 /// One identified parameter in `result.json`.
@@ -82,6 +87,8 @@ pub struct IdentifyResult {
     pub wall_seconds: f64,
     /// Share of the run's CPU time (wall time × worker threads) spent in forward simulations.
     pub forward_share: f64,
+    /// Times the run was interrupted and resumed.
+    pub resumed: usize,
     /// Warnings worth reading.
     pub warnings: Vec<String>,
 }
@@ -107,6 +114,18 @@ impl Problem for Timed<'_> {
     }
     fn objectives(&self) -> usize {
         self.inner.objectives()
+    }
+}
+
+/// Aborts the process once `.0` evaluations are done, leaving files as a kill would.
+struct AbortAfter(Option<usize>);
+
+impl Observer for AbortAfter {
+    fn observe(&mut self, p: &Progress<'_>) -> bool {
+        if self.0.is_some_and(|n| p.evaluations >= n) {
+            std::process::abort();
+        }
+        true
     }
 }
 
@@ -142,15 +161,36 @@ pub fn optimize(
     resume: Option<&str>,
     observer: &mut dyn Observer,
 ) -> Result<Run> {
+    let method = method_from_config(name, settings)?;
+    if resume.is_some() && matches!(method, Method::Local(_)) {
+        return Err(CzError::config("--resume", format!("`{name}` keeps no state; it resumes from its journal")));
+    }
+    optimize_with(id, &method, seed, budget, resume, None, observer)
+}
+
+/// [`optimize`] with a built method; a local method's evaluations go through `journal` when given
+/// (at `path`: recorded, and replayed when it already holds them).
+fn optimize_with(
+    id: &Identification,
+    method: &Method,
+    seed: u64,
+    budget: &Budget,
+    resume: Option<&str>,
+    journal: Option<(&std::path::Path, bool)>,
+    observer: &mut dyn Observer,
+) -> Result<Run> {
     let timed = Timed { inner: id, nanos: AtomicU64::new(0) };
     let start = Instant::now();
-    let result = match method_from_config(name, settings)? {
-        Method::Local(_) if resume.is_some() => {
-            return Err(CzError::config("--resume", format!("`{name}` cannot resume; run it again")));
-        }
+    let result = match method {
         Method::Local(local) => {
             let u0 = id.space().to_unit(&id.initial()?);
-            local.minimize_from(&timed, budget, &u0, observer)?
+            match journal {
+                Some((path, replay)) => {
+                    let j = if replay { Journal::resume(&timed, path)? } else { Journal::create(&timed, path)? };
+                    local.minimize_from(&j, budget, &u0, observer)?
+                }
+                None => local.minimize_from(&timed, budget, &u0, observer)?,
+            }
         }
         Method::Global(optimizer) => match resume {
             Some(state) => optimizer.resume(&timed, budget, state, observer)?,
@@ -185,24 +225,51 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         return Err(CzError::config("--budget", "must be at least 1 evaluation"));
     }
     let x0 = id.initial()?;
+    // Everything that can be refused is checked before a file is touched: the method, and what
+    // a resume needs.
+    let method = method_from_config(&name, &settings)?;
+    let fingerprint = Fingerprint::of(&id, &problem.experiments, &label, &settings, seed, budget.evaluations)?;
+    let earlier_run = if opts.resume { Some(RunFile::for_resume(out, &fingerprint)?) } else { None };
+    let local = matches!(method, Method::Local(_));
+    let journal_path = out.file("evaluations.jsonl");
+    let resume_state = match (opts.resume, local) {
+        (true, false) => Some(czid_optimizers::checkpoint::read_checkpoint(&out.file("checkpoint.json"))?),
+        (true, true) if !journal_path.exists() => {
+            return Err(CzError::Io {
+                path: journal_path.display().to_string(),
+                message: "the interrupted run left no journal of its evaluations; start afresh with --force".into(),
+            })
+        }
+        _ => None,
+    };
+    // A resumed global method keeps the rows written before the interruption; a local method
+    // replays its run and writes them again.
+    let earlier = if opts.resume && !local { std::fs::read_to_string(out.file("history.csv")).ok() } else { None };
 
-    // A resumed run keeps the rows written before the interruption.
-    let earlier = if opts.resume { std::fs::read_to_string(out.file("history.csv")).ok() } else { None };
+    let mut clock = RunClock::start(out, fingerprint, earlier_run)?;
     let mut history = CsvHistory::create(&out.file("history.csv"))?;
     let mut checkpoint = CheckpointWriter::new(out.file("checkpoint.json"), 1)?;
     let mut bar =
         if opts.progress { ProgressBar::new(budget.evaluations) } else { ProgressBar::hidden(budget.evaluations) };
     let mut stop = StopFlag(opts.stop.clone(), false);
-    let resume_state = if opts.resume {
-        Some(czid_optimizers::checkpoint::read_checkpoint(&out.file("checkpoint.json"))?)
-    } else {
-        None
-    };
+    let mut abort = AbortAfter(opts.abort_after);
     let run = {
-        let mut observers = Observers(vec![&mut history, &mut checkpoint, &mut bar, &mut stop]);
-        optimize(&id, &name, &settings, seed, &budget, resume_state.as_deref(), &mut observers)?
+        let mut observers = Observers(vec![&mut history, &mut checkpoint, &mut clock, &mut bar, &mut stop, &mut abort]);
+        let journal = local.then_some((journal_path.as_path(), opts.resume));
+        optimize_with(&id, &method, seed, &budget, resume_state.as_deref(), journal, &mut observers)
     };
-    let (result, wall, forward_seconds) = (run.result, run.wall_seconds, run.forward_seconds);
+    let run = match run {
+        Ok(run) => run,
+        Err(e) => {
+            // A resume that failed leaves the interrupted run's history as it was.
+            if let Some(text) = &earlier {
+                out.write("history.csv", text)?;
+            }
+            return Err(e);
+        }
+    };
+    let (result, forward_seconds) = (run.result, run.forward_seconds);
+    let wall = clock.finish()?;
     bar.finish();
     history.finish()?;
     relabel_history(&id, out, earlier.as_deref())?;
@@ -247,7 +314,8 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         evaluations: result.evaluations,
         failed_evaluations: result.failures,
         wall_seconds: wall,
-        forward_share: forward_seconds / (wall.max(1e-12) * rayon::current_num_threads() as f64),
+        forward_share: forward_seconds / (run.wall_seconds.max(1e-12) * rayon::current_num_threads() as f64),
+        resumed: clock.resumed(),
         warnings,
     };
     let json = serde_json::to_string_pretty(&res).map_err(|e| CzError::config("result", e.to_string()))?;
@@ -317,8 +385,9 @@ fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &OutputDir, stem:
 }
 
 /// Rewrites `history.csv` with physical values under `path (unit)` headers instead of the
-/// optimizer's unit-cube coordinates `x0, x1, …`, after the rows of an interrupted run (`earlier`,
-/// already relabelled) when this one resumed it.
+/// optimizer's unit-cube coordinates `x0, x1, …`, after the rows of an interrupted run (`earlier`:
+/// relabelled already when that run ended on a signal, not when it was killed) when this one
+/// resumed it.
 fn relabel_history(id: &Identification, out: &OutputDir, earlier: Option<&str>) -> Result<()> {
     let path = out.file("history.csv");
     let text = std::fs::read_to_string(&path)
@@ -331,18 +400,25 @@ fn relabel_history(id: &Identification, out: &OutputDir, earlier: Option<&str>) 
     outtext.extend(params.iter().map(|p| format!("{} ({})", p.path, p.unit)));
     let mut result = outtext.join(",");
     result.push('\n');
-    for line in earlier.into_iter().flat_map(|e| e.lines().skip(1)) {
-        result.push_str(line);
-        result.push('\n');
-    }
-    for line in lines {
+    let physical = |line: &str| -> String {
         let cells: Vec<&str> = line.split(',').collect();
         let mut row: Vec<String> = cells.iter().take(fixed).map(|c| c.to_string()).collect();
         for (p, c) in params.iter().zip(cells.iter().skip(fixed)) {
             let u: f64 = c.parse().unwrap_or(f64::NAN);
             row.push(format!("{}", p.from_unit(u)));
         }
-        result.push_str(&row.join(","));
+        row.join(",")
+    };
+    let rows: Vec<&str> = lines.collect();
+    let first_new = rows.first().and_then(|l| l.split(',').next()).and_then(|c| c.parse::<usize>().ok());
+    let kept = earlier.map(|e| earlier_rows(e, first_new)).unwrap_or_default();
+    let relabelled = kept.first().is_some_and(|h| *h == result.trim_end());
+    for line in kept.iter().skip(1) {
+        result.push_str(&if relabelled { line.clone() } else { physical(line) });
+        result.push('\n');
+    }
+    for line in rows {
+        result.push_str(&physical(line));
         result.push('\n');
     }
     out.write("history.csv", &result).map(|_| ())

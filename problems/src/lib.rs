@@ -11,6 +11,8 @@
 //! * [`output`]: output folders that are never clobbered by accident, files written atomically.
 //! * [`plot`]: line plots (PNG/SVG) with a bundled font, written atomically (from czid-optimizers).
 //! * [`problem_file`]: the TOML problem file (law, experiments, parameters, objective, optimizer).
+//! * [`resume`]: what an identification keeps to continue after an interruption (fingerprint,
+//!   wall time, history).
 //! * [`synthetic`]: synthetic tests with documented noise, for studies with a known truth.
 
 pub mod compare;
@@ -22,4 +24,5 @@ pub mod identify;
 pub mod output;
 pub use czid_optimizers::plot;
 pub mod problem_file;
+pub mod resume;
 pub mod synthetic;

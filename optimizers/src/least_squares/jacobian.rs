@@ -84,10 +84,24 @@ pub fn jacobian<S: ResidualSource>(
             }
         }
     }
-    let mut rs = Vec::with_capacity(points.len());
-    for r in src.residuals(&points)? {
-        rs.push(r?);
+    let mut rs = src.residuals(&points)?;
+    if fd.scheme == Differences::Central {
+        // A central point whose run failed is replaced by the point itself (a one-sided
+        // difference) when its residuals are known; otherwise the Jacobian fails.
+        if let Some(r0) = r0 {
+            for c in 0..columns.len() {
+                let (plus, minus) = (rs[2 * c].is_err(), rs[2 * c + 1].is_err());
+                if plus != minus {
+                    let j = columns[c];
+                    let failed = if plus { 2 * c } else { 2 * c + 1 };
+                    rs[failed] = Ok(r0.to_vec());
+                    let other = if plus { points[2 * c + 1][j] } else { points[2 * c][j] };
+                    widths[c] = if plus { z[j] - other } else { other - z[j] };
+                }
+            }
+        }
     }
+    let rs: Vec<Vec<f64>> = rs.into_iter().collect::<Result<_, _>>()?;
     let base = match (fd.scheme, r0) {
         (Differences::Central, _) => None,
         (Differences::Forward, Some(r)) => Some(r.to_vec()),
@@ -144,9 +158,13 @@ mod tests {
     }
 
     #[test]
-    fn a_failed_point_fails_the_jacobian() {
-        let src = Parallel(|z: &[f64]| if z[0] > 0.5 { Err("diverged") } else { Ok(vec![z[0]]) });
+    fn a_failed_point_gives_a_one_sided_difference_or_fails_the_jacobian() {
+        let src = Parallel(|z: &[f64]| if z[0] > 0.5 { Err("diverged") } else { Ok(vec![2.0 * z[0]]) });
         let fd = FiniteDifferences { step: 1e-3, scheme: Differences::Central };
+        // Without the residuals at the point there is nothing to difference against.
         assert_eq!(jacobian(&src, &[0.5], None, &fd, None, &[0]).unwrap_err(), "diverged");
+        // With them, the backward difference.
+        let j = jacobian(&src, &[0.5], Some(&[1.0]), &fd, None, &[0]).unwrap();
+        assert!((j[(0, 0)] - 2.0).abs() < 1e-9, "{}", j[(0, 0)]);
     }
 }

@@ -1,0 +1,115 @@
+//! Interrupted identifications resume to the uninterrupted result, bit for bit, for every kind of
+//! optimizer; the interruption is a deterministic abort after a number of evaluations (what a
+//! `SIGKILL` leaves: no partial result, files as they were at that instant).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const PROBLEM: &str = "examples/hartlen-dcb/dcb01.toml";
+
+fn czid(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_czid")).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("czid-resume-{}-{name}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    dir
+}
+
+fn identify(out: &Path, optimizer: &str, budget: &str, extra: &[&str]) -> Output {
+    identify_file(PROBLEM, out, optimizer, budget, extra)
+}
+
+fn identify_file(problem: &str, out: &Path, optimizer: &str, budget: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["identify", problem, "--optimizer", optimizer, "--budget", budget, "--out"];
+    let out = out.to_str().unwrap();
+    args.push(out);
+    args.extend_from_slice(extra);
+    czid(&args)
+}
+
+/// `result.json` without what depends on the clock or on the interruption itself.
+fn result(dir: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap();
+    for k in ["wall_seconds", "forward_share", "resumed"] {
+        v.as_object_mut().unwrap().remove(k);
+    }
+    v
+}
+
+fn killed_then_resumed_equals_whole(optimizer: &str, budget: &str, abort_after: &str) {
+    let whole = scratch(&format!("{optimizer}-whole"));
+    assert!(identify(&whole, optimizer, budget, &[]).status.success());
+    let cut = scratch(&format!("{optimizer}-cut-{abort_after}"));
+    let killed = identify(&cut, optimizer, budget, &["--abort-after-evaluations", abort_after]);
+    assert!(!killed.status.success(), "{optimizer}: the abort did not happen");
+    assert!(!cut.join("result.json").exists());
+    let resumed = identify(&cut, optimizer, budget, &["--resume"]);
+    assert!(resumed.status.success(), "{optimizer}: {}", String::from_utf8_lossy(&resumed.stderr));
+    assert!(String::from_utf8_lossy(&resumed.stdout).contains("resumed an interrupted run"));
+    assert_eq!(result(&cut), result(&whole), "{optimizer} aborted after {abort_after} evaluations");
+    assert_eq!(
+        std::fs::read_to_string(cut.join("history.csv")).unwrap(),
+        std::fs::read_to_string(whole.join("history.csv")).unwrap(),
+        "{optimizer}: history"
+    );
+    for d in [whole, cut] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}
+
+#[test]
+fn every_kind_of_optimizer_resumes_after_a_kill_to_the_uninterrupted_result() {
+    killed_then_resumed_equals_whole("levenberg-marquardt", "60", "30");
+    killed_then_resumed_equals_whole("nelder-mead", "60", "30");
+    killed_then_resumed_equals_whole("miga", "200", "100");
+    // The hybrid (MIGA on 160 evaluations, then its polish): killed in either phase.
+    killed_then_resumed_equals_whole("hybrid", "200", "100");
+    killed_then_resumed_equals_whole("hybrid", "200", "180");
+}
+
+#[test]
+fn a_resume_of_a_different_run_is_refused_and_changes_nothing() {
+    let out = scratch("different");
+    assert!(!identify(&out, "miga", "300", &["--abort-after-evaluations", "150"]).status.success());
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    // The same problem with a wider bound on the strength.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let wider = std::fs::read_to_string(root.join(PROBLEM))
+        .unwrap()
+        .replace("upper = 80.0", "upper = 90.0")
+        .replace("\"../../data/", &format!("\"{}/data/", root.display()));
+    let wider_file = out.with_extension("toml");
+    std::fs::write(&wider_file, wider).unwrap();
+    let o = identify_file(wider_file.to_str().unwrap(), &out, "miga", "300", &["--resume"]);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(!o.status.success() && err.contains("parameters: law.strength_n in [5, 80]"), "{err}");
+    std::fs::remove_file(wider_file).ok();
+    for (extra, named) in
+        [(vec!["--seed", "7"], "seed: 1 before, 7 now"), (vec!["--set", "law.g_ic=0.5"], "law and models")]
+    {
+        let mut args = vec!["--resume"];
+        args.extend(extra.iter().copied());
+        let o = identify(&out, "miga", "300", &args);
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(!o.status.success(), "{extra:?} was accepted");
+        assert!(err.contains("not this run") && err.contains(named), "{extra:?}: {err}");
+        assert_eq!(std::fs::read_to_string(out.join("history.csv")).unwrap(), history, "{extra:?} touched history.csv");
+    }
+    let o = identify(&out, "miga", "400", &["--resume"]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("budget: 300 before, 400 now"));
+    std::fs::remove_dir_all(out).ok();
+}
+
+#[test]
+fn a_run_that_fails_to_start_leaves_no_files_in_the_way() {
+    let out = scratch("no-start");
+    let o = identify(&out, "no-such-method", "100", &[]);
+    assert!(!o.status.success());
+    // The corrected run starts without --force.
+    let o = identify(&out, "nelder-mead", "30", &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_dir_all(out).ok();
+}
