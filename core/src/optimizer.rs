@@ -145,6 +145,13 @@ pub trait Optimizer {
         observer: &mut dyn Observer,
     ) -> Result<OptimizationResult>;
 
+    /// Whether the method ends on its own convergence criterion (a local method, or a global
+    /// search followed by a local polish), so that a run that spent its whole budget had not
+    /// converged. Population methods that always spend their budget keep the default `false`.
+    fn stops_when_converged(&self) -> bool {
+        false
+    }
+
     /// Continues a run from a state saved through [`Observer::checkpoint`], with a possibly
     /// different budget; the final result equals that of an uninterrupted run. Optimizers that
     /// cannot resume keep this default, which says so.

@@ -198,6 +198,11 @@ impl Optimizer for Hybrid {
         "hybrid"
     }
 
+    /// The polish ends on the local method's criterion.
+    fn stops_when_converged(&self) -> bool {
+        true
+    }
+
     fn minimize(
         &self,
         problem: &dyn Problem,

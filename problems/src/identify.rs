@@ -89,6 +89,9 @@ pub struct IdentifyResult {
     pub forward_share: f64,
     /// Times the run was interrupted and resumed.
     pub resumed: usize,
+    /// Whether the optimizer converged before its budget ran out (see the book's criterion per
+    /// method); when not, the verdicts are marked provisional.
+    pub converged: bool,
     /// Warnings worth reading.
     pub warnings: Vec<String>,
 }
@@ -204,6 +207,56 @@ fn optimize_with(
     })
 }
 
+/// A global method whose best value still fell by more than this share over the last quarter of
+/// its budget had not converged.
+const STILL_IMPROVING: f64 = 1e-3;
+/// ...and the run must have had at least this many iterations (generations), so that its last
+/// quarter spans a few.
+const ITERATIONS_TO_TELL: usize = 20;
+
+/// Whether the run converged within its budget. A local method (and the hybrid, whose polish is
+/// one) converged when it stopped on its own criterion, before spending the budget. A population
+/// method always spends its budget: it converged when it ran at least [`ITERATIONS_TO_TELL`]
+/// iterations and its best value fell by less than [`STILL_IMPROVING`] (relative) over the last
+/// quarter of the evaluations.
+/// Returns why not, or `None` when it did.
+fn unconverged(method: &Method, result: &OptimizationResult, budget: usize, iterations: usize) -> Option<String> {
+    match method {
+        Method::Local(_) if result.evaluations < budget => None,
+        Method::Global(g) if g.stops_when_converged() && result.evaluations < budget => None,
+        Method::Local(_) => Some("the method was still iterating when its last evaluation was spent".into()),
+        Method::Global(g) if g.stops_when_converged() => {
+            Some("its local polish was still iterating when its last evaluation was spent".into())
+        }
+        Method::Global(_) if iterations < ITERATIONS_TO_TELL => {
+            Some(format!("{iterations} iterations are too few to tell (at least {ITERATIONS_TO_TELL})"))
+        }
+        Method::Global(_) => {
+            let last = result.history.last().map_or(f64::INFINITY, |h| h.1);
+            let start = result.evaluations - result.evaluations / 4;
+            let before = result.history.iter().rev().find(|(n, _)| *n <= start).map_or(f64::INFINITY, |h| h.1);
+            (before - last > STILL_IMPROVING * before.abs()).then(|| {
+                format!(
+                    "the best value still fell by {:.2} % over the last quarter of the budget (converged: under {:.1} %)",
+                    100.0 * (before - last) / before.abs(),
+                    100.0 * STILL_IMPROVING
+                )
+            })
+        }
+    }
+}
+
+/// Counts the iterations of a run.
+#[derive(Default)]
+struct Iterations(usize);
+
+impl Observer for Iterations {
+    fn observe(&mut self, _: &Progress<'_>) -> bool {
+        self.0 += 1;
+        true
+    }
+}
+
 /// The verdict in words, with the relative standard error of a determined parameter.
 fn describe_with_error(verdict: &Verdict, space: &czid_core::ParameterSpace, value: f64, se: Option<f64>) -> String {
     match (verdict, se) {
@@ -253,8 +306,17 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         if opts.progress { ProgressBar::new(budget.evaluations) } else { ProgressBar::hidden(budget.evaluations) };
     let mut stop = StopFlag(opts.stop.clone(), false);
     let mut abort = AbortAfter(opts.abort_after);
+    let mut iterations = Iterations::default();
     let run = {
-        let mut observers = Observers(vec![&mut history, &mut checkpoint, &mut clock, &mut bar, &mut stop, &mut abort]);
+        let mut observers = Observers(vec![
+            &mut history,
+            &mut checkpoint,
+            &mut clock,
+            &mut bar,
+            &mut iterations,
+            &mut stop,
+            &mut abort,
+        ]);
         let journal = local.then_some((journal_path.as_path(), opts.resume));
         optimize_with(&id, &method, seed, &budget, resume_state.as_deref(), journal, &mut observers)
     };
@@ -278,6 +340,13 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     let x = id.space().from_unit(&result.best_x);
     let outcome = id.simulate(&x)?;
     let mut warnings: Vec<String> = outcome.failures.clone();
+    let why = if partial { None } else { unconverged(&method, &result, budget.evaluations, iterations.0) };
+    let converged = !partial && why.is_none();
+    if let Some(why) = why {
+        warnings.push(format!(
+            "budget exhausted before convergence: {why}; the values and their verdicts are provisional (raise --budget)"
+        ));
+    }
     let assessment = assess(&id, &result.best_x)?;
     let mut parameters = BTreeMap::new();
     for (i, p) in id.space().parameters().iter().enumerate() {
@@ -293,7 +362,11 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
                 initial: x0[i],
                 bounds: [p.lower, p.upper],
                 standard_error: assessment.standard_errors[i],
-                verdict: describe_with_error(verdict, id.space(), x[i], assessment.standard_errors[i]),
+                verdict: match describe_with_error(verdict, id.space(), x[i], assessment.standard_errors[i]) {
+                    v if converged => v,
+                    v if partial => format!("{v}, provisional: the run was interrupted"),
+                    v => format!("{v}, provisional: budget exhausted before convergence"),
+                },
             },
         );
     }
@@ -316,6 +389,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         wall_seconds: wall,
         forward_share: forward_seconds / (run.wall_seconds.max(1e-12) * rayon::current_num_threads() as f64),
         resumed: clock.resumed(),
+        converged,
         warnings,
     };
     let json = serde_json::to_string_pretty(&res).map_err(|e| CzError::config("result", e.to_string()))?;

@@ -247,7 +247,12 @@ impl LoadedProblem {
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
         czid_models::registry::ensure_linked();
         let shown = path.display().to_string();
-        let file: ProblemFile = toml::from_str(text).map_err(|e| CzError::config(&shown, e.to_string().trim_end()))?;
+        let file: ProblemFile = toml::from_str(text).map_err(|e| {
+            // A wrong type inside a law or model is reported against its table (they are read
+            // through their `type` tag): name the key as well.
+            let at = wrong_type_key(text, e.message()).map(|k| format!("\n(the value is at {k})")).unwrap_or_default();
+            CzError::config(&shown, format!("{}{at}", e.to_string().trim_end()))
+        })?;
         file.law.validate().map_err(|e| CzError::config(format!("{shown}, [law]"), e.to_string()))?;
         if file.experiment.is_empty() {
             return Err(CzError::config(&shown, "at least one [[experiment]] is needed"));
@@ -326,6 +331,51 @@ impl LoadedProblem {
             models.insert(data.name.clone(), duplicate(&entry.model, "problem")?);
         }
         Ok(Setup { law, models })
+    }
+}
+
+/// Where the value named by a serde "invalid type: string \"40\", expected f64" message sits in
+/// the file: `key \`law.strength_n\`, line 7`, when one key holds that value.
+fn wrong_type_key(text: &str, message: &str) -> Option<String> {
+    let rest = message.strip_prefix("invalid type: ")?;
+    let (found, _) = rest.split_once(", expected")?;
+    let wanted: toml::Value = if let Some(q) = found.strip_prefix("string ") {
+        toml::Value::String(q.trim_matches('"').to_string())
+    } else if let Some(b) = found.strip_prefix("boolean `") {
+        toml::Value::Boolean(b.trim_end_matches('`') == "true")
+    } else {
+        return None;
+    };
+    let doc: toml::Table = toml::from_str(text).ok()?;
+    let mut hits = Vec::new();
+    find_value(&toml::Value::Table(doc), &wanted, String::new(), &mut hits);
+    let [key] = hits.as_slice() else { return None };
+    let leaf = key.rsplit('.').next()?;
+    let line = text.lines().position(|l| {
+        let l = l.trim_start();
+        l.starts_with(leaf) && l[leaf.len()..].trim_start().starts_with('=')
+    });
+    Some(match line {
+        Some(n) => format!("key `{key}`, line {}", n + 1),
+        None => format!("key `{key}`"),
+    })
+}
+
+fn find_value(node: &toml::Value, wanted: &toml::Value, path: String, hits: &mut Vec<String>) {
+    match node {
+        toml::Value::Table(t) => {
+            for (k, v) in t {
+                let p = if path.is_empty() { k.clone() } else { format!("{path}.{k}") };
+                find_value(v, wanted, p, hits);
+            }
+        }
+        toml::Value::Array(a) => {
+            for (i, v) in a.iter().enumerate() {
+                find_value(v, wanted, format!("{path}[{i}]"), hits);
+            }
+        }
+        v if v == wanted => hits.push(path),
+        _ => {}
     }
 }
 

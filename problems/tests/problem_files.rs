@@ -169,6 +169,12 @@ fn bad_inputs_are_named() {
             "at least 2",
         ),
         ("infinite-bound", problem_text("").replace("upper = 200.0", "upper = inf"), "upper"),
+        // A number written as a string inside the law: the key and its line are named.
+        (
+            "quoted-number",
+            problem_text("").replace("stiffness = 50.0", "stiffness = \"50\""),
+            "`law.stiffness`, line 4",
+        ),
         (
             "subnormal-log-bound",
             problem_text("").replace("lower = 10.0\nupper = 200.0", "lower = 5e-324\nupper = 200.0\nscale = \"log\""),
@@ -330,4 +336,33 @@ fn named_optimizers_resolve_by_label_and_are_checked_when_read() {
         let msg = read(&bad).unwrap_err().to_string();
         assert!(msg.contains(expect), "`{msg}` should mention `{expect}`");
     }
+}
+
+#[test]
+fn a_budget_that_ends_before_convergence_is_said_and_qualifies_the_verdicts() {
+    use czid_problems::identify::{identify, RunOptions};
+    use czid_problems::output::OutputDir;
+    let dir = setup_dir("budget", &problem_text(""));
+    let p = read(&dir).unwrap();
+    let run = |name: &str, optimizer: &str, budget: usize| {
+        let out = OutputDir::create(&dir.join(name), false, false).unwrap();
+        let opts = RunOptions { optimizer: Some(optimizer.into()), budget: Some(budget), ..RunOptions::default() };
+        identify(&p, &opts, &out).unwrap()
+    };
+    // MIGA: one generation of 100 is too few to tell; Levenberg–Marquardt: 3 evaluations end it
+    // mid-step. Both say so, and every verdict is marked provisional.
+    for res in [run("miga-short", "miga", 100), run("lm-short", "levenberg-marquardt", 3)] {
+        assert!(!res.converged, "{}", res.optimizer);
+        assert!(
+            res.warnings.iter().any(|w| w.starts_with("budget exhausted before convergence")),
+            "{:?}",
+            res.warnings
+        );
+        let verdict = &res.parameters["law.stiffness"].verdict;
+        assert!(verdict.ends_with("provisional: budget exhausted before convergence"), "{verdict}");
+    }
+    // Levenberg–Marquardt that stops on its own criterion well inside its budget converged.
+    let res = run("lm-long", "levenberg-marquardt", 500);
+    assert!(res.evaluations < 500 && res.converged, "{} evaluations", res.evaluations);
+    assert!(!res.parameters["law.stiffness"].verdict.contains("provisional"));
 }

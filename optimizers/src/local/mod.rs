@@ -254,6 +254,10 @@ macro_rules! local_optimizer {
                 $name
             }
 
+            fn stops_when_converged(&self) -> bool {
+                true
+            }
+
             fn minimize(
                 &self,
                 problem: &dyn czid_core::Problem,
