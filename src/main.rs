@@ -206,6 +206,9 @@ fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Res
     let dir = OutputDir::create(&out.out, out.force, false)?;
     let outcome = simulate(&problem, &dir)?;
     println!("curves and plots written to {}", dir.path().display());
+    for w in czid_problems::identify::short_runs(&problem, &outcome) {
+        println!("warning: {w}");
+    }
     if outcome.failures.is_empty() {
         Ok(())
     } else {

@@ -79,6 +79,29 @@ fn bad_input_fails_with_a_message_naming_it() {
             vec!["identify", "examples/paper-dcb/problem.toml", "--out", o, "--set", "law.strength_n=100"],
             "within its bounds",
         ),
+        // Meshes that cannot resolve the law, or would take gigabytes, are refused before a run.
+        (
+            vec![
+                "simulate",
+                "examples/hartlen-dcb/dcb01.toml",
+                "--out",
+                o,
+                "--set",
+                "models.dcb01.mesh.interface_element=1000",
+            ],
+            "longer than the law's cohesive zone (about 4.287 mm",
+        ),
+        (
+            vec![
+                "simulate",
+                "examples/hartlen-dcb/dcb01.toml",
+                "--out",
+                o,
+                "--set",
+                "models.dcb01.mesh.interface_element=1e-5",
+            ],
+            "far finer than any cohesive zone needs",
+        ),
     ];
     for (args, expect) in cases {
         let r = czid(&args);
@@ -144,5 +167,23 @@ fn without_a_terminal_identify_prints_progress_lines_for_the_log() {
     // One line per tenth of the 120-evaluation budget, the last at the end of the budget.
     assert!(lines.len() >= 5, "{lines:?}");
     assert!(lines.last().unwrap().starts_with("progress: 120/120 evaluations"), "{lines:?}");
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
+fn a_model_that_stops_before_the_data_end_is_named() {
+    let out = scratch("short");
+    let o = out.to_str().unwrap();
+    let args = [
+        "simulate",
+        "examples/hartlen-dcb/dcb01.toml",
+        "--out",
+        o,
+        "--set",
+        "models.dcb01.control.max_displacement=10",
+    ];
+    let r = czid(&args);
+    let stdout = String::from_utf8_lossy(&r.stdout);
+    assert!(stdout.contains("stops at 10.0000 mm but its test runs to 30.8101 mm"), "{stdout}");
     std::fs::remove_dir_all(&out).ok();
 }

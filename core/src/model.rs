@@ -48,6 +48,14 @@ pub trait ForwardModel: Send + Sync + std::fmt::Debug {
     /// of [`crate::columns`] that the model measures.
     fn simulate(&self, law: &dyn CohesiveLaw) -> Result<Record, SimulationFailure>;
 
+    /// Checks that the model resolves `law` (e.g. that its interface elements are shorter than the
+    /// law's cohesive zone): an error for a mesh that cannot, notes for a marginal one (default:
+    /// nothing to check). Called once on the initial law when a problem is read, not per run.
+    fn check_law(&self, law: &dyn CohesiveLaw) -> crate::error::Result<Vec<String>> {
+        let _ = law;
+        Ok(Vec::new())
+    }
+
     /// The model's switchable effects (default: none). Each declared field must exist in the
     /// model's configuration, and at the declared null value the model must simulate exactly as
     /// without the effect; the diagnosis builds its candidate effects from these declarations.

@@ -340,6 +340,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     let x = id.space().from_unit(&result.best_x);
     let outcome = id.simulate(&x)?;
     let mut warnings: Vec<String> = outcome.failures.clone();
+    warnings.extend(short_runs(problem, &outcome));
     let why = if partial { None } else { unconverged(&method, &result, budget.evaluations, iterations.0) };
     let converged = !partial && why.is_none();
     if let Some(why) = why {
@@ -363,7 +364,8 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
                 bounds: [p.lower, p.upper],
                 standard_error: assessment.standard_errors[i],
                 verdict: match describe_with_error(verdict, id.space(), x[i], assessment.standard_errors[i]) {
-                    v if converged => v,
+                    // Data that do not determine a parameter do not at any point.
+                    v if converged || matches!(verdict, Verdict::NotDetermined) => v,
                     v if partial => format!("{v}, provisional: the run was interrupted"),
                     v => format!("{v}, provisional: budget exhausted before convergence"),
                 },
@@ -401,6 +403,29 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     write_fits(problem, &outcome, out, "fit")?;
     convergence_plot(&result, out)?;
     Ok(res)
+}
+
+/// Experiments whose simulation ends before their last reading: the readings beyond are compared
+/// with the run's last state, which makes the parameters look undetermined; said in words.
+pub fn short_runs(problem: &LoadedProblem, outcome: &Outcome) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in &problem.experiments {
+        let Some(ended) =
+            outcome.records.get(&e.name).and_then(|r| r.column(columns::DISPLACEMENT).ok()?.last().copied())
+        else {
+            continue;
+        };
+        let last = e.load.x_max();
+        if ended < 0.99 * last {
+            out.push(format!(
+                "the model of `{}` stops at {ended:.4} mm but its test runs to {last:.4} mm: the readings beyond are \
+                 compared with the model's last state (raise the model's control.max_displacement, or see why the \
+                 run stopped)",
+                e.name
+            ));
+        }
+    }
+    out
 }
 
 /// Runs every experiment's model at the initial values; writes `curves.csv` (or

@@ -191,6 +191,9 @@ pub struct LoadedProblem {
     pub file: ProblemFile,
     /// The experiments' data, in file order.
     pub experiments: Vec<Experiment>,
+    /// What the models said of their meshes against the initial law (see
+    /// [`czid_core::ForwardModel::check_law`]).
+    pub mesh_notes: Vec<String>,
 }
 
 impl LoadedProblem {
@@ -270,11 +273,12 @@ impl LoadedProblem {
         let base = path.parent().unwrap_or(Path::new("."));
         let mut experiments = Vec::new();
         let mut names = Vec::new();
+        let mut mesh_notes = Vec::new();
         for (i, entry) in file.experiment.iter().enumerate() {
-            entry
-                .model
-                .validate()
-                .map_err(|e| CzError::config(format!("{shown}, experiment {}: model", i + 1), e.to_string()))?;
+            let owner = format!("{shown}, experiment {}: model", i + 1);
+            entry.model.validate().map_err(|e| CzError::config(&owner, e.to_string()))?;
+            let notes = entry.model.check_law(file.law.as_ref()).map_err(|e| CzError::config(&owner, e.to_string()))?;
+            mesh_notes.extend(notes.into_iter().map(|n| format!("experiment {}: {n}", i + 1)));
             let mut data = entry.data.load(base)?;
             if let Some(n) = &entry.name {
                 data.name = n.clone();
@@ -289,13 +293,14 @@ impl LoadedProblem {
             experiments.push(data);
         }
         ParameterSpace::new(file.parameter.clone()).map_err(|e| CzError::config(&shown, e.to_string()))?;
-        Ok(LoadedProblem { path: path.to_path_buf(), file, experiments })
+        Ok(LoadedProblem { path: path.to_path_buf(), file, experiments, mesh_notes })
     }
 
     /// What reading the data left out, one line per experiment that lost rows (e.g.
     /// `dcb01: rows dropped: 12 whose displacement does not increase`), for the user to see.
     pub fn reading_notes(&self) -> Vec<String> {
-        self.experiments.iter().filter_map(|e| e.dropped.describe().map(|d| format!("{}: {d}", e.name))).collect()
+        let dropped = self.experiments.iter().filter_map(|e| e.dropped.describe().map(|d| format!("{}: {d}", e.name)));
+        dropped.chain(self.mesh_notes.iter().cloned()).collect()
     }
 
     /// The identification problem this file describes (weights set as the file asks).
