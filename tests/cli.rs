@@ -79,6 +79,25 @@ fn bad_input_fails_with_a_message_naming_it() {
             vec!["identify", "examples/paper-dcb/problem.toml", "--out", o, "--set", "law.strength_n=100"],
             "within its bounds",
         ),
+        // A hybrid whose global phase cannot run on its share of the budget says so, in identify and
+        // in compare (before any run).
+        (
+            vec!["identify", "examples/paper-dcb/problem.toml", "--out", o, "--optimizer", "hybrid", "--budget", "100"],
+            "its global phase (miga) gets 80 of the budget's 100 evaluations",
+        ),
+        (
+            vec![
+                "compare",
+                "examples/paper-dcb/problem.toml",
+                "--out",
+                o,
+                "--optimizers",
+                "lm,hybrid",
+                "--budget",
+                "100",
+            ],
+            "its global phase (miga) gets 80",
+        ),
         // Meshes that cannot resolve the law, or would take gigabytes, are refused before a run.
         (
             vec![
@@ -107,6 +126,7 @@ fn bad_input_fails_with_a_message_naming_it() {
         let r = czid(&args);
         assert!(!r.status.success(), "{args:?} should fail");
         assert!(stderr(&r).contains(expect), "{args:?}: `{}` should mention `{expect}`", stderr(&r));
+        assert!(!stderr(&r).contains(" seed   1: f ="), "{args:?} ran before failing");
         std::fs::remove_dir_all(&out).ok();
     }
 }

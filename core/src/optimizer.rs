@@ -152,6 +152,13 @@ pub trait Optimizer {
         false
     }
 
+    /// Refuses a budget the method cannot run with (e.g. smaller than its initial population),
+    /// so that a caller can check every run before starting any. `minimize` checks it too.
+    fn check_budget(&self, budget: &Budget) -> Result<()> {
+        let _ = budget;
+        Ok(())
+    }
+
     /// Continues a run from a state saved through [`Observer::checkpoint`], with a possibly
     /// different budget; the final result equals that of an uninterrupted run. Optimizers that
     /// cannot resume keep this default, which says so.

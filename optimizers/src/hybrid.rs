@@ -203,6 +203,23 @@ impl Optimizer for Hybrid {
         true
     }
 
+    fn check_budget(&self, budget: &Budget) -> Result<()> {
+        let global = self.split(budget);
+        self.global.check_budget(&global).map_err(|e| {
+            CzError::config(
+                "optimizer hybrid",
+                format!(
+                    "its global phase ({}) gets {} of the budget's {} evaluations (the rest, local_fraction = {}, is \
+                     the polish's) and cannot run with them: {e}. Raise the budget or lower local_fraction",
+                    self.global.name(),
+                    global.evaluations,
+                    budget.evaluations,
+                    self.local_fraction
+                ),
+            )
+        })
+    }
+
     fn minimize(
         &self,
         problem: &dyn Problem,
@@ -210,6 +227,7 @@ impl Optimizer for Hybrid {
         seed: u64,
         observer: &mut dyn Observer,
     ) -> Result<OptimizationResult> {
+        self.check_budget(budget)?;
         let mut phase = GlobalPhase { inner: observer, stopped: false };
         let g = self.global.minimize(problem, &self.split(budget), seed, &mut phase)?;
         if phase.stopped {

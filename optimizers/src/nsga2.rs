@@ -174,6 +174,19 @@ impl Optimizer for Nsga2 {
         "nsga2"
     }
 
+    fn check_budget(&self, budget: &Budget) -> Result<()> {
+        let n = self.settings.population;
+        if budget.evaluations < n {
+            return Err(CzError::invalid(
+                "optimizer nsga2",
+                "budget.evaluations",
+                budget.evaluations as f64,
+                format!("the initial population alone needs {n} evaluations"),
+            ));
+        }
+        Ok(())
+    }
+
     fn minimize(
         &self,
         problem: &dyn Problem,
@@ -183,14 +196,7 @@ impl Optimizer for Nsga2 {
     ) -> Result<OptimizationResult> {
         let n = self.settings.population;
         let bounds = eval::checked_bounds(problem)?;
-        if budget.evaluations < n {
-            return Err(CzError::invalid(
-                "optimizer nsga2",
-                "budget.evaluations",
-                budget.evaluations as f64,
-                format!("the initial population alone needs {n} evaluations"),
-            ));
-        }
+        self.check_budget(budget)?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let xs: Vec<Vec<f64>> =
             (0..n).map(|_| bounds.iter().map(|&(lo, hi)| lo + (hi - lo) * rng.random::<f64>()).collect()).collect();

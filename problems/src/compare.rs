@@ -10,6 +10,7 @@ use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
 use crate::problem_file::LoadedProblem;
 use czid_core::{Budget, CzError, NoObserver, Result};
+use czid_optimizers::registry::{method_from_config, Method};
 
 /// What to compare.
 #[derive(Clone, Debug)]
@@ -54,6 +55,13 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
     let id = problem.identification()?;
     let budget = Budget { evaluations: opts.budget.unwrap_or(problem.file.optimizer.budget), target: None };
     let grid: Vec<usize> = (1..=50).map(|k| (budget.evaluations * k).div_ceil(50)).collect();
+    // Every optimizer and its budget are checked before the first run, not after the others ran.
+    for name in &opts.optimizers {
+        let (kind, settings) = problem.file.optimizer_named(name);
+        if let Method::Global(g) = method_from_config(&kind, &settings)? {
+            g.check_budget(&budget)?;
+        }
+    }
     let mut runs = Vec::new();
     for name in &opts.optimizers {
         let (kind, settings) = problem.file.optimizer_named(name);

@@ -281,6 +281,9 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     // Everything that can be refused is checked before a file is touched: the method, and what
     // a resume needs.
     let method = method_from_config(&name, &settings)?;
+    if let Method::Global(g) = &method {
+        g.check_budget(&budget)?;
+    }
     let fingerprint = Fingerprint::of(&id, &problem.experiments, &label, &settings, seed, budget.evaluations)?;
     let earlier_run = if opts.resume { Some(RunFile::for_resume(out, &fingerprint)?) } else { None };
     let local = matches!(method, Method::Local(_));

@@ -243,6 +243,19 @@ impl Optimizer for Miga {
         self.name
     }
 
+    fn check_budget(&self, budget: &Budget) -> Result<()> {
+        let needed = self.settings.initial_evaluations();
+        if budget.evaluations < needed {
+            return Err(CzError::invalid(
+                format!("optimizer {}", self.name),
+                "budget.evaluations",
+                budget.evaluations as f64,
+                format!("the initial population alone needs {needed} evaluations"),
+            ));
+        }
+        Ok(())
+    }
+
     fn minimize(
         &self,
         problem: &dyn Problem,
@@ -252,15 +265,8 @@ impl Optimizer for Miga {
     ) -> Result<OptimizationResult> {
         let s = &self.settings;
         let codec = self.codec(problem)?;
+        self.check_budget(budget)?;
         let needed = s.initial_evaluations();
-        if budget.evaluations < needed {
-            return Err(CzError::invalid(
-                format!("optimizer {}", self.name),
-                "budget.evaluations",
-                budget.evaluations as f64,
-                format!("the initial population alone needs {needed} evaluations"),
-            ));
-        }
         let dim = problem.dim();
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mask = codec.mask();
