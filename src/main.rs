@@ -192,6 +192,14 @@ fn exit_after_signal() -> ExitCode {
     }
 }
 
+/// Whether `path` is a model file (a top-level `[model]` table and no `[[experiment]]`).
+fn is_model_file(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .is_some_and(|t| t.contains_key("model") && !t.contains_key("experiment"))
+}
+
 /// Reads a problem file and says what reading its data left out.
 fn read_problem(problem: &Path, sets: &[(String, String)]) -> Result<LoadedProblem, CzError> {
     let problem = LoadedProblem::read_with(problem, sets)?;
@@ -202,6 +210,14 @@ fn read_problem(problem: &Path, sets: &[(String, String)]) -> Result<LoadedProbl
 }
 
 fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
+    if sets.is_empty() && is_model_file(problem) {
+        // A model file (`[law]` and `[model]`, no test data): the forward run alone.
+        let file = TruthFile::read(problem)?;
+        let dir = OutputDir::create(&out.out, out.force, false)?;
+        let record = czid_problems::identify::simulate_model(&file, &dir)?;
+        println!("{} steps; curves and plot written to {}", record.rows(), dir.path().display());
+        return Ok(());
+    }
     let problem = read_problem(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, false)?;
     let outcome = simulate(&problem, &dir)?;

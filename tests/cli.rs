@@ -207,3 +207,26 @@ fn a_model_that_stops_before_the_data_end_is_named() {
     assert!(stdout.contains("stops at 10.0000 mm but its test runs to 30.8101 mm"), "{stdout}");
     std::fs::remove_dir_all(&out).ok();
 }
+
+#[test]
+fn a_model_file_without_data_simulates_and_synthesizes_with_partial_noise() {
+    let out = scratch("model-only");
+    let o = out.to_str().unwrap();
+    // The paper's truth file: [law], [model] and [noise], no test data.
+    let r = czid(&["simulate", "examples/paper-dcb/truth.toml", "--out", o]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let curves = std::fs::read_to_string(out.join("curves.csv")).unwrap();
+    assert!(curves.starts_with("displacement (mm),load (N)"), "{}", &curves[..80]);
+    assert!(out.join("curves-load.png").exists());
+    // A [noise] table giving only the load noise: the rest take their defaults.
+    let truth =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/paper-dcb/truth.toml")).unwrap();
+    let head = truth.split("[noise]").next().unwrap();
+    let file = out.join("partial-noise.toml");
+    std::fs::write(&file, format!("{head}[noise]\nload_sd = 0.02\n")).unwrap();
+    let csv = out.join("synthetic.csv");
+    let r = czid(&["synthesize", file.to_str().unwrap(), "--out", csv.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 1 + 200);
+    std::fs::remove_dir_all(&out).ok();
+}

@@ -431,6 +431,44 @@ pub fn short_runs(problem: &LoadedProblem, outcome: &Outcome) -> Vec<String> {
     out
 }
 
+/// Runs a model file's model (`[law]` and `[model]`, as in a truth file; no test data) and writes
+/// `curves.csv` and `curves-load.png`.
+pub fn simulate_model(file: &crate::synthetic::TruthFile, out: &OutputDir) -> Result<czid_core::Record> {
+    let (record, stopped) = match file.model.simulate(file.law.as_ref()) {
+        Ok(r) => (r, None),
+        Err(f) if f.partial.rows() >= 2 => (f.partial.clone(), Some(f.to_string())),
+        Err(f) => return Err(CzError::Simulation(f.to_string())),
+    };
+    let (header, cols): (Vec<String>, Vec<Vec<f64>>) = RECORDED
+        .iter()
+        .filter_map(|c| {
+            let v = record.column(c).ok()?;
+            Some((format!("{c} ({})", record.unit(c).unwrap_or("-")), v.to_vec()))
+        })
+        .unzip();
+    out.write_csv("curves.csv", &header, &cols)?;
+    let sim = record.curve(columns::DISPLACEMENT, columns::LOAD)?;
+    Figure::new(&format!("{}: load", file.model.name()), "displacement (mm)", "load (N)")
+        .with(Series::line("model", sim.x().to_vec(), sim.y().to_vec()))
+        .save(&out.file("curves-load.png"))?;
+    match stopped {
+        None => Ok(record),
+        Some(why) => Err(CzError::Simulation(format!("stopped early (curves hold the converged steps): {why}"))),
+    }
+}
+
+/// The record columns written to `curves.csv` and `fit.csv`, when the model records them.
+const RECORDED: [&str; 8] = [
+    columns::DISPLACEMENT,
+    columns::LOAD,
+    columns::DEBONDED_LENGTH,
+    columns::PROCESS_ZONE_LENGTH,
+    columns::CRACK_TIP,
+    columns::EXTERNAL_WORK,
+    columns::ELASTIC_ENERGY,
+    columns::DISSIPATED_ENERGY,
+];
+
 /// Runs every experiment's model at the initial values; writes `curves.csv` (or
 /// `curves-<experiment>.csv` when there are several) and plots against the data.
 pub fn simulate(problem: &LoadedProblem, out: &OutputDir) -> Result<Outcome> {
@@ -450,19 +488,9 @@ fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &OutputDir, stem:
     for e in &problem.experiments {
         let record = &outcome.records[&e.name];
         let suffix = if several { format!("-{}", e.name) } else { String::new() };
-        let wanted = [
-            columns::DISPLACEMENT,
-            columns::LOAD,
-            columns::DEBONDED_LENGTH,
-            columns::PROCESS_ZONE_LENGTH,
-            columns::CRACK_TIP,
-            columns::EXTERNAL_WORK,
-            columns::ELASTIC_ENERGY,
-            columns::DISSIPATED_ENERGY,
-        ];
         let mut header = Vec::new();
         let mut cols = Vec::new();
-        for c in wanted {
+        for c in RECORDED {
             if let Ok(v) = record.column(c) {
                 header.push(format!("{c} ({})", record.unit(c).unwrap_or("-")));
                 cols.push(v.to_vec());

@@ -127,13 +127,15 @@ pub struct TruthFile {
     pub law: Box<dyn czid_core::CohesiveLaw>,
     /// The forward model.
     pub model: Box<dyn czid_core::ForwardModel>,
-    /// Noise and sampling.
+    /// Noise and sampling (default: no noise, 200 readings).
+    #[serde(default)]
     pub noise: NoiseSpec,
 }
 
-/// The `[noise]` table of a truth file.
+/// The `[noise]` table of a truth file; every field has a default (no noise, seed 1, 200
+/// readings to the end of the simulation).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct NoiseSpec {
     /// Standard deviation of load readings (N).
     pub load_sd: f64,
@@ -144,8 +146,13 @@ pub struct NoiseSpec {
     /// Number of equally spaced readings.
     pub points: usize,
     /// Last displacement read (mm); default: the end of the simulation.
-    #[serde(default)]
     pub max_displacement: Option<f64>,
+}
+
+impl Default for NoiseSpec {
+    fn default() -> Self {
+        NoiseSpec { load_sd: 0.0, length_sd: 0.0, seed: 1, points: 200, max_displacement: None }
+    }
 }
 
 impl TruthFile {
