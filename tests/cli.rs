@@ -230,3 +230,28 @@ fn a_model_file_without_data_simulates_and_synthesizes_with_partial_noise() {
     assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 1 + 200);
     std::fs::remove_dir_all(&out).ok();
 }
+
+#[test]
+fn a_test_driven_past_the_specimen_split_ends_there_without_bogus_rows() {
+    let out = scratch("split");
+    let o = out.to_str().unwrap();
+    let args = [
+        "simulate",
+        "examples/hartlen-dcb/dcb01.toml",
+        "--out",
+        o,
+        "--set",
+        "models.dcb01.control.max_displacement=200",
+    ];
+    let r = czid(&args);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let text = std::fs::read_to_string(out.join("curves.csv")).unwrap();
+    let rows: Vec<Vec<f64>> =
+        text.lines().skip(1).map(|l| l.split(',').map(|c| c.parse().unwrap()).collect()).collect();
+    // Openings and loads stay positive; the run stops once the ligament ahead of the crack is
+    // shorter than the cohesive zone (about 4.3 mm of the 123 mm specimen).
+    assert!(rows.iter().all(|r| r[0] >= 0.0 && r[1] >= 0.0), "a row with a negative opening or load");
+    let tip = rows.last().unwrap()[4];
+    assert!(tip > 123.0 - 4.4 && tip < 123.0, "last crack tip {tip}");
+    std::fs::remove_dir_all(&out).ok();
+}

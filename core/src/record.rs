@@ -68,6 +68,13 @@ impl Record {
         }
     }
 
+    /// Keeps the first `rows` rows.
+    pub fn truncate(&mut self, rows: usize) {
+        for c in &mut self.columns {
+            c.values.truncate(rows);
+        }
+    }
+
     /// Number of rows (converged steps).
     pub fn rows(&self) -> usize {
         self.columns.first().map_or(0, |c| c.values.len())

@@ -166,6 +166,22 @@ impl Dcb {
         (self.material.e11 * gc / (sigma * sigma)).powf(0.25) * self.h.powf(0.75)
     }
 
+    /// The record up to the step where the bonded ligament left ahead of the crack front is
+    /// shorter than the law's cohesive zone (or two interface elements): the specimen is then
+    /// splitting and the steps after it (the arms springing back, openings falling below zero)
+    /// describe no test. `Err` (with the record unchanged) when the crack never got there.
+    fn until_split(&self, mut record: Record, law: &dyn CohesiveLaw) -> std::result::Result<Record, Record> {
+        let zone = self.cohesive_zone_length(law);
+        let end = self.length - (2.0 * self.mesh.interface_element).max(if zone.is_finite() { zone } else { 0.0 });
+        let Some(split) =
+            record.column(czid_core::columns::CRACK_TIP).ok().and_then(|tip| tip.iter().position(|&t| t >= end))
+        else {
+            return Err(record);
+        };
+        record.truncate(split + 1);
+        Ok(record)
+    }
+
     /// Crack length the mesh uses: `a0 + effects.crack_length_offset` (mm).
     pub fn effective_crack_length(&self) -> f64 {
         self.a0 + self.effects.crack_length_offset
@@ -324,7 +340,11 @@ impl ForwardModel for Dcb {
         law.validate().map_err(fail)?;
         let (p, scale) = self.problem().map_err(fail)?;
         let path = self.path(law, &scale);
-        beamtest::run(&p, law, &path, &RUN, &scale).map(|(record, _)| record)
+        match beamtest::run(&p, law, &path, &RUN, &scale) {
+            Ok((record, _)) => Ok(self.until_split(record, law).unwrap_or_else(|r| r)),
+            // A run that fails once the crack has run through the specimen ended the test.
+            Err(f) => self.until_split(f.partial.clone(), law).map_err(|_| f),
+        }
     }
 }
 
