@@ -1,6 +1,9 @@
 //! The `czid` command: simulate, identify and compare on problem files; the bundled demo.
 
+mod cluster;
 mod commands;
+
+use cluster::Cluster;
 
 use clap::{Args, Parser, Subcommand};
 use czid_core::CzError;
@@ -129,12 +132,28 @@ struct OutArgs {
     force: bool,
 }
 
+fn fail(e: &CzError) -> ExitCode {
+    eprintln!("error: {e}");
+    ExitCode::FAILURE
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Demo { out } => demo(&out),
         Command::Simulate { problem, out, set } => run_simulate(&problem, &set.sets, &out),
         Command::Identify { problem, out, set, optimizer, seed, budget, resume, abort_after_evaluations } => {
+            let cluster = Cluster::join();
+            if cluster.is_worker() {
+                // Every rank builds the same problem; only rank 0 writes anything.
+                return match LoadedProblem::read_with(&problem, &set.sets).and_then(|p| p.identification()) {
+                    Ok(id) => match cluster.serve(&id) {
+                        Ok(()) => ExitCode::SUCCESS,
+                        Err(e) => fail(&e),
+                    },
+                    Err(e) => fail(&e),
+                };
+            }
             let opts = RunOptions {
                 optimizer,
                 seed,
@@ -143,8 +162,11 @@ fn main() -> ExitCode {
                 resume,
                 stop: Some(interrupt_flag()),
                 abort_after: abort_after_evaluations,
+                spread: cluster.spread(),
             };
-            run_identify(&problem, &set.sets, &out, &opts)
+            let outcome = run_identify(&problem, &set.sets, &out, &opts);
+            cluster.finish();
+            outcome
         }
         Command::Harness(args) => commands::harness::run(&args),
         Command::Diagnose(args) => commands::diagnose::run(&args),
@@ -156,10 +178,7 @@ fn main() -> ExitCode {
     };
     match outcome {
         Ok(()) => exit_after_signal(),
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
+        Err(e) => fail(&e),
     }
 }
 

@@ -39,7 +39,8 @@ pub use law::{law_from_toml, law_to_toml, CohesiveLaw, Gap, LawEval, LawState, P
 pub use model::{ForwardModel, SimulationFailure};
 pub use objective::{CompositeObjective, ObjectiveTerm, ObjectiveValue};
 pub use optimizer::{
-    Budget, Evaluation, NoObserver, Observer, OptimizationResult, Optimizer, Problem, Progress, Snapshot,
+    BatchEvaluator, Batched, Budget, Evaluation, NoObserver, Observer, OptimizationResult, Optimizer, Problem,
+    Progress, Snapshot,
 };
 pub use param::{Parameter, ParameterSpace, Scale};
 pub use record::{columns, Column, Record};

@@ -34,9 +34,54 @@ pub trait Problem: Sync {
     fn bounds(&self) -> Vec<(f64, f64)>;
     /// Evaluates a candidate.
     fn evaluate(&self, x: &[f64]) -> Result<Evaluation>;
+    /// Evaluates a batch of candidates; result `k` belongs to `xs[k]`. The default runs them on
+    /// rayon's threads (one alone on the calling thread). Wrappers forward the batch to the
+    /// problem they wrap, so that a [`BatchEvaluator`] at the bottom can send it elsewhere.
+    fn evaluate_batch(&self, xs: &[Vec<f64>]) -> Vec<Result<Evaluation>> {
+        use rayon::prelude::*;
+        if xs.len() == 1 {
+            vec![self.evaluate(&xs[0])]
+        } else {
+            xs.par_iter().map(|x| self.evaluate(x)).collect()
+        }
+    }
     /// Number of separate objectives in [`Evaluation::objectives`] (1 when only `value`).
     fn objectives(&self) -> usize {
         1
+    }
+}
+
+/// Where the candidates of a batch are evaluated: on this process's threads, or spread over
+/// processes that each hold an identical copy of the problem (MPI ranks). Result `k` must belong
+/// to `xs[k]` whatever the spreading, so that optimizers stay deterministic.
+pub trait BatchEvaluator: Send + Sync {
+    /// Evaluates `xs` with `problem` or its copies.
+    fn evaluate(&self, problem: &dyn Problem, xs: &[Vec<f64>]) -> Vec<Result<Evaluation>>;
+}
+
+/// A problem whose batches go through a [`BatchEvaluator`].
+pub struct Batched<'a> {
+    /// The problem.
+    pub problem: &'a dyn Problem,
+    /// Where its batches are evaluated.
+    pub by: &'a dyn BatchEvaluator,
+}
+
+impl Problem for Batched<'_> {
+    fn dim(&self) -> usize {
+        self.problem.dim()
+    }
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        self.problem.bounds()
+    }
+    fn evaluate(&self, x: &[f64]) -> Result<Evaluation> {
+        self.problem.evaluate(x)
+    }
+    fn evaluate_batch(&self, xs: &[Vec<f64>]) -> Vec<Result<Evaluation>> {
+        self.by.evaluate(self.problem, xs)
+    }
+    fn objectives(&self) -> usize {
+        self.problem.objectives()
     }
 }
 

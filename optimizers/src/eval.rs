@@ -2,7 +2,6 @@
 //! failures, exact best-so-far bookkeeping.
 
 use czid_core::{Evaluation, Problem, Result};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Isight's default "failed run objective value": what a failed evaluation scores.
@@ -86,12 +85,7 @@ pub fn evaluate_batch(
     tracker: &mut Tracker,
 ) -> Vec<Evaluation> {
     let m = problem.objectives();
-    let raw: Vec<Result<Evaluation>> = if xs.len() == 1 {
-        // Avoid rayon's overhead for the sequential (local-method) case.
-        vec![problem.evaluate(&xs[0])]
-    } else {
-        xs.par_iter().map(|x| problem.evaluate(x)).collect()
-    };
+    let raw: Vec<Result<Evaluation>> = problem.evaluate_batch(xs);
     raw.into_iter()
         .zip(xs)
         .map(|(r, x)| {

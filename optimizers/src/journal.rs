@@ -137,15 +137,29 @@ impl Problem for Journal<'_> {
     }
 
     fn evaluate(&self, x: &[f64]) -> Result<Evaluation> {
-        let key: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
-        if let Some(known) = self.known.get(&key) {
-            self.replayed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            return known.as_ref().map(Bits::evaluation).map_err(|e| CzError::Simulation(e.clone()));
+        self.evaluate_batch(std::slice::from_ref(&x.to_vec())).remove(0)
+    }
+
+    /// The candidates the journal holds are served from it; the others go to the wrapped problem
+    /// as one batch and are journaled.
+    fn evaluate_batch(&self, xs: &[Vec<f64>]) -> Vec<Result<Evaluation>> {
+        let keys: Vec<Vec<u64>> = xs.iter().map(|x| x.iter().map(|v| v.to_bits()).collect()).collect();
+        let fresh: Vec<usize> = (0..xs.len()).filter(|&k| !self.known.contains_key(&keys[k])).collect();
+        let fresh_xs: Vec<Vec<f64>> = fresh.iter().map(|&k| xs[k].clone()).collect();
+        let mut computed = self.inner.evaluate_batch(&fresh_xs).into_iter();
+        let mut out = Vec::with_capacity(xs.len());
+        for (k, key) in keys.into_iter().enumerate() {
+            if let Some(known) = self.known.get(&key) {
+                self.replayed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                out.push(known.as_ref().map(Bits::evaluation).map_err(|e| CzError::Simulation(e.clone())));
+                continue;
+            }
+            debug_assert!(fresh.contains(&k));
+            let outcome = computed.next().expect("one result per fresh candidate");
+            let entry = Entry { x: key, outcome: outcome.as_ref().map(Bits::of).map_err(|e| e.to_string()) };
+            out.push(self.append(&entry).and(outcome));
         }
-        let outcome = self.inner.evaluate(x);
-        let entry = Entry { x: key, outcome: outcome.as_ref().map(Bits::of).map_err(|e| e.to_string()) };
-        self.append(&entry)?;
-        outcome
+        out
     }
 }
 

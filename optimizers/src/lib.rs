@@ -28,6 +28,8 @@ pub mod least_squares;
 pub mod local;
 pub mod metrics;
 pub mod miga;
+#[cfg(feature = "mpi")]
+pub mod mpi;
 pub mod nsga2;
 pub mod observers;
 pub mod plot;

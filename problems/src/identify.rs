@@ -7,7 +7,10 @@ use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
 use crate::problem_file::LoadedProblem;
 use crate::resume::{earlier_rows, Fingerprint, RunClock, RunFile};
-use czid_core::{columns, Budget, CzError, Evaluation, Observer, OptimizationResult, Problem, Progress, Result};
+use czid_core::{
+    columns, BatchEvaluator, Batched, Budget, CzError, Evaluation, Observer, OptimizationResult, Problem, Progress,
+    Result,
+};
 use czid_optimizers::checkpoint::CheckpointWriter;
 use czid_optimizers::journal::Journal;
 use czid_optimizers::observers::{CsvHistory, Observers, ProgressBar};
@@ -37,6 +40,18 @@ pub struct RunOptions {
     /// Abort the process, as a `SIGKILL` would, once this many evaluations are done (for tests
     /// of what an interruption leaves behind).
     pub abort_after: Option<usize>,
+    /// Where the batches of evaluations go (default: this process's threads); e.g. MPI ranks.
+    pub spread: Option<Spread>,
+}
+
+/// A [`BatchEvaluator`] shared by the runs of a command.
+#[derive(Clone)]
+pub struct Spread(pub Arc<dyn BatchEvaluator>);
+
+impl std::fmt::Debug for Spread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Spread(..)")
+    }
 }
 
 /// One identified parameter in `result.json`.
@@ -168,11 +183,13 @@ pub fn optimize(
     if resume.is_some() && matches!(method, Method::Local(_)) {
         return Err(CzError::config("--resume", format!("`{name}` keeps no state; it resumes from its journal")));
     }
-    optimize_with(id, &method, seed, budget, resume, None, observer)
+    optimize_with(id, &method, seed, budget, resume, None, None, observer)
 }
 
 /// [`optimize`] with a built method; a local method's evaluations go through `journal` when given
-/// (at `path`: recorded, and replayed when it already holds them).
+/// (at `path`: recorded, and replayed when it already holds them), and every batch through
+/// `spread` when given.
+#[allow(clippy::too_many_arguments)]
 fn optimize_with(
     id: &Identification,
     method: &Method,
@@ -180,24 +197,30 @@ fn optimize_with(
     budget: &Budget,
     resume: Option<&str>,
     journal: Option<(&std::path::Path, bool)>,
+    spread: Option<&dyn BatchEvaluator>,
     observer: &mut dyn Observer,
 ) -> Result<Run> {
     let timed = Timed { inner: id, nanos: AtomicU64::new(0) };
+    let batched = spread.map(|by| Batched { problem: &timed, by });
+    let problem: &dyn Problem = match &batched {
+        Some(b) => b,
+        None => &timed,
+    };
     let start = Instant::now();
     let result = match method {
         Method::Local(local) => {
             let u0 = id.space().to_unit(&id.initial()?);
             match journal {
                 Some((path, replay)) => {
-                    let j = if replay { Journal::resume(&timed, path)? } else { Journal::create(&timed, path)? };
+                    let j = if replay { Journal::resume(problem, path)? } else { Journal::create(problem, path)? };
                     local.minimize_from(&j, budget, &u0, observer)?
                 }
-                None => local.minimize_from(&timed, budget, &u0, observer)?,
+                None => local.minimize_from(problem, budget, &u0, observer)?,
             }
         }
         Method::Global(optimizer) => match resume {
-            Some(state) => optimizer.resume(&timed, budget, state, observer)?,
-            None => optimizer.minimize(&timed, budget, seed, observer)?,
+            Some(state) => optimizer.resume(problem, budget, state, observer)?,
+            None => optimizer.minimize(problem, budget, seed, observer)?,
         },
     };
     Ok(Run {
@@ -246,13 +269,14 @@ fn unconverged(method: &Method, result: &OptimizationResult, budget: usize, iter
     }
 }
 
-/// Counts the iterations of a run.
+/// Counts the iterations of a run, those before a resume included (iterations are numbered from
+/// 0 across the parts of a resumed run).
 #[derive(Default)]
 struct Iterations(usize);
 
 impl Observer for Iterations {
-    fn observe(&mut self, _: &Progress<'_>) -> bool {
-        self.0 += 1;
+    fn observe(&mut self, p: &Progress<'_>) -> bool {
+        self.0 = self.0.max(p.iteration + 1);
         true
     }
 }
@@ -321,7 +345,8 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
             &mut abort,
         ]);
         let journal = local.then_some((journal_path.as_path(), opts.resume));
-        optimize_with(&id, &method, seed, &budget, resume_state.as_deref(), journal, &mut observers)
+        let spread = opts.spread.as_ref().map(|s| s.0.as_ref());
+        optimize_with(&id, &method, seed, &budget, resume_state.as_deref(), journal, spread, &mut observers)
     };
     let run = match run {
         Ok(run) => run,

@@ -1,0 +1,71 @@
+//! `mpiexec -n 2 czid identify ...` gives the serial result bit for bit, with evaluations done on
+//! both ranks, and a killed 2-rank run resumes to it (on one rank as well). Built and run with
+//! `cargo test --features mpi --test mpi` on a machine with MPI (`mpiexec` on the path).
+#![cfg(feature = "mpi")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const PROBLEM: &str = "examples/paper-dcb/problem.toml";
+
+fn run(ranks: Option<usize>, out: &Path, extra: &[&str]) -> Output {
+    let bin = env!("CARGO_BIN_EXE_czid");
+    let mut args: Vec<String> = Vec::new();
+    if let Some(n) = ranks {
+        args.extend(["-n".to_string(), n.to_string(), bin.to_string()]);
+    }
+    let base = ["identify", PROBLEM, "--optimizer", "miga", "--budget", "400", "--out", out.to_str().unwrap()];
+    args.extend(base.iter().map(|s| s.to_string()));
+    args.extend(extra.iter().map(|s| s.to_string()));
+    let program = if ranks.is_some() { "mpiexec" } else { bin };
+    Command::new(program).args(&args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("czid-mpi-{}-{name}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    dir
+}
+
+fn result(dir: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap();
+    for k in ["wall_seconds", "forward_share", "resumed"] {
+        v.as_object_mut().unwrap().remove(k);
+    }
+    v
+}
+
+#[test]
+fn two_ranks_give_the_serial_result_and_a_killed_run_resumes_to_it() {
+    let serial = scratch("serial");
+    assert!(run(None, &serial, &[]).status.success());
+
+    let two = scratch("two");
+    let o = run(Some(2), &two, &[]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(result(&two), result(&serial));
+    assert_eq!(
+        std::fs::read_to_string(two.join("history.csv")).unwrap(),
+        std::fs::read_to_string(serial.join("history.csv")).unwrap()
+    );
+    // Both ranks evaluated: "evaluations on 2 ranks: rank 0: a, rank 1: b" with a, b > 0.
+    let line = stdout.lines().find(|l| l.starts_with("evaluations on 2 ranks")).expect("the per-rank counts");
+    let counts: Vec<usize> =
+        line.split(": ").skip(2).map(|c| c.split(',').next().unwrap().trim().parse().unwrap()).collect();
+    assert!(counts.len() == 2 && counts.iter().all(|&c| c > 0), "{line}");
+
+    // Killed on 2 ranks after 200 evaluations; resumed on 2 ranks and on 1.
+    for resume_ranks in [Some(2), None] {
+        let cut = scratch(&format!("cut-{resume_ranks:?}"));
+        assert!(!run(Some(2), &cut, &["--abort-after-evaluations", "200"]).status.success());
+        let r = run(resume_ranks, &cut, &["--resume"]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        assert_eq!(result(&cut), result(&serial), "resumed on {resume_ranks:?} ranks");
+        std::fs::remove_dir_all(cut).ok();
+    }
+    for d in [serial, two] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}
