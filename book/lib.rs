@@ -15,6 +15,8 @@ pub mod forward_models {}
 pub mod frp_beam {}
 #[doc = include_str!("src/optimizers.md")]
 pub mod optimizers {}
+#[doc = include_str!("src/cluster.md")]
+pub mod cluster {}
 #[doc = include_str!("src/problem_files.md")]
 pub mod problem_files {}
 #[doc = include_str!("src/quick_start.md")]
