@@ -132,6 +132,15 @@ struct OutArgs {
     force: bool,
 }
 
+/// A rank other than 0: builds the same problem as rank 0 (only rank 0 writes anything) and
+/// evaluates what it sends.
+fn serve(cluster: &Cluster, problem: &Path, sets: &[(String, String)]) -> ExitCode {
+    match LoadedProblem::read_with(problem, sets).and_then(|p| p.identification()).and_then(|id| cluster.serve(&id)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => fail(&e),
+    }
+}
+
 fn fail(e: &CzError) -> ExitCode {
     eprintln!("error: {e}");
     ExitCode::FAILURE
@@ -145,14 +154,7 @@ fn main() -> ExitCode {
         Command::Identify { problem, out, set, optimizer, seed, budget, resume, abort_after_evaluations } => {
             let cluster = Cluster::join();
             if cluster.is_worker() {
-                // Every rank builds the same problem; only rank 0 writes anything.
-                return match LoadedProblem::read_with(&problem, &set.sets).and_then(|p| p.identification()) {
-                    Ok(id) => match cluster.serve(&id) {
-                        Ok(()) => ExitCode::SUCCESS,
-                        Err(e) => fail(&e),
-                    },
-                    Err(e) => fail(&e),
-                };
+                return serve(&cluster, &problem, &set.sets);
             }
             let opts = RunOptions {
                 optimizer,
@@ -173,7 +175,14 @@ fn main() -> ExitCode {
         Command::GapBench(args) => commands::gap_bench::run(&args),
         Command::Synthesize { truth, out, force } => run_synthesize(&truth, &out, force),
         Command::Compare { problem, optimizers, seeds, budget, target, out, set } => {
-            run_compare(&problem, &set.sets, &out, &CompareOptions { optimizers, seeds, budget, target })
+            let cluster = Cluster::join();
+            if cluster.is_worker() {
+                return serve(&cluster, &problem, &set.sets);
+            }
+            let opts = CompareOptions { optimizers, seeds, budget, target, spread: cluster.spread() };
+            let outcome = run_compare(&problem, &set.sets, &out, &opts);
+            cluster.finish();
+            outcome
         }
     };
     match outcome {

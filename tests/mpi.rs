@@ -69,3 +69,50 @@ fn two_ranks_give_the_serial_result_and_a_killed_run_resumes_to_it() {
         std::fs::remove_dir_all(d).ok();
     }
 }
+
+fn compare(ranks: Option<usize>, out: &Path) -> Output {
+    let bin = env!("CARGO_BIN_EXE_czid");
+    let base = [
+        "compare",
+        PROBLEM,
+        "--optimizers",
+        "miga,lm",
+        "--seeds",
+        "2",
+        "--budget",
+        "200",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let mut cmd = match ranks {
+        Some(n) => {
+            let mut c = Command::new("mpiexec");
+            c.args(["-n", &n.to_string(), bin]);
+            c
+        }
+        None => Command::new(bin),
+    };
+    cmd.args(base).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+}
+
+/// `summary.csv` without its wall-time column.
+fn summary(dir: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    let rows: Vec<Vec<String>> = text.lines().map(|l| l.split(',').map(str::to_string).collect()).collect();
+    let keep: Vec<usize> = (0..rows[0].len()).filter(|&i| rows[0][i] != "wall_seconds").collect();
+    rows.iter().map(|r| keep.iter().map(|&i| r[i].clone()).collect()).collect()
+}
+
+#[test]
+fn compare_on_two_ranks_gives_the_serial_table() {
+    let serial = scratch("compare-serial");
+    assert!(compare(None, &serial).status.success());
+    let two = scratch("compare-two");
+    let o = compare(Some(2), &two);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(summary(&two), summary(&serial));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("evaluations on 2 ranks"));
+    for d in [serial, two] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}

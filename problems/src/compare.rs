@@ -24,6 +24,8 @@ pub struct CompareOptions {
     /// Objective value counted as success (default 1e-3: a thousandfold reduction from the
     /// balanced initial guess).
     pub target: f64,
+    /// Where the runs' batches go (default: this process's threads), e.g. MPI ranks.
+    pub spread: Option<crate::identify::Spread>,
 }
 
 /// One run's outcome.
@@ -66,7 +68,8 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
     for name in &opts.optimizers {
         let (kind, settings) = problem.file.optimizer_named(name);
         for seed in 1..=opts.seeds {
-            let run = optimize(&id, &kind, &settings, seed, &budget, None, &mut NoObserver)?;
+            let spread = opts.spread.as_ref().map(|s| s.0.as_ref());
+            let run = optimize(&id, &kind, &settings, seed, &budget, None, spread, &mut NoObserver)?;
             let h = &run.result.history;
             let at = |n: usize| h.iter().take_while(|(e, _)| *e <= n).last().map_or(f64::NAN, |(_, v)| *v);
             let curve = grid.iter().map(|&n| at(n)).collect();

@@ -169,7 +169,9 @@ pub struct Run {
 }
 
 /// Runs optimizer `name` with `settings` on `id`. Local methods start from the initial values;
-/// global ones sample the bounds. `resume` continues from a checkpoint's state.
+/// global ones sample the bounds. `resume` continues from a checkpoint's state; batches go
+/// through `spread` when given (e.g. MPI ranks).
+#[allow(clippy::too_many_arguments)]
 pub fn optimize(
     id: &Identification,
     name: &str,
@@ -177,13 +179,14 @@ pub fn optimize(
     seed: u64,
     budget: &Budget,
     resume: Option<&str>,
+    spread: Option<&dyn BatchEvaluator>,
     observer: &mut dyn Observer,
 ) -> Result<Run> {
     let method = method_from_config(name, settings)?;
     if resume.is_some() && matches!(method, Method::Local(_)) {
         return Err(CzError::config("--resume", format!("`{name}` keeps no state; it resumes from its journal")));
     }
-    optimize_with(id, &method, seed, budget, resume, None, None, observer)
+    optimize_with(id, &method, seed, budget, resume, None, spread, observer)
 }
 
 /// [`optimize`] with a built method; a local method's evaluations go through `journal` when given

@@ -237,8 +237,13 @@ fn compare_runs_every_optimizer_and_seed_and_writes_summary() {
     let dir = setup_dir("compare", &problem_text("").replace("budget = 100", "budget = 200"));
     let p = read(&dir).unwrap();
     let out = OutputDir::create(&dir.join("out"), false, false).unwrap();
-    let opts =
-        CompareOptions { optimizers: vec!["miga".into(), "nelder-mead".into()], seeds: 2, budget: None, target: 1e-3 };
+    let opts = CompareOptions {
+        optimizers: vec!["miga".into(), "nelder-mead".into()],
+        seeds: 2,
+        budget: None,
+        target: 1e-3,
+        spread: None,
+    };
     let runs = compare(&p, &opts, &out).unwrap();
     assert_eq!(runs.len(), 4);
     assert!(runs.iter().all(|r| r.evaluations <= 200));

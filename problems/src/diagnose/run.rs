@@ -314,6 +314,7 @@ pub fn diagnose(problem: &LoadedProblem, library: &Library, opts: &Options) -> R
                 spec.seed,
                 &budget,
                 None,
+                None,
                 &mut Quiet,
             )?;
             run.result.best_x
