@@ -62,15 +62,51 @@ impl Cluster {
         }
     }
 
+    /// Where rank 0 runs a benchmark's cases (`None` on one rank).
+    pub fn case_farm(&self) -> Option<Box<dyn czid_problems::diagnose::bench::CaseFarm + '_>> {
+        #[cfg(feature = "mpi")]
+        if let Some(e) = &self.evaluator {
+            return Some(Box::new(MpiFarm(e)));
+        }
+        None
+    }
+
+    /// On a rank other than 0: runs the tasks rank 0 farms out with `run(id)`.
+    pub fn serve_tasks(&self, run: &dyn Fn(usize) -> String) -> Result<(), CzError> {
+        #[cfg(feature = "mpi")]
+        {
+            czid_optimizers::mpi::serve_tasks(run);
+            Ok(())
+        }
+        #[cfg(not(feature = "mpi"))]
+        {
+            let _ = run;
+            Err(CzError::config("mpi", "this czid was built without the `mpi` feature"))
+        }
+    }
+
     /// On rank 0, once the command is over (whether it succeeded or not): releases the other
-    /// ranks and says how many evaluations each did.
-    pub fn finish(&self) {
+    /// ranks and says how many `units` (evaluations, cases) each did.
+    pub fn finish(&self, units: &str) {
+        #[cfg(not(feature = "mpi"))]
+        let _ = units;
         #[cfg(feature = "mpi")]
         if let Some(e) = &self.evaluator {
             czid_optimizers::mpi::finish();
             let counts = e.counts();
             let shown: Vec<String> = counts.iter().enumerate().map(|(r, n)| format!("rank {r}: {n}")).collect();
-            println!("evaluations on {} ranks: {}", self.size, shown.join(", "));
+            println!("{units} on {} ranks: {}", self.size, shown.join(", "));
         }
+    }
+}
+
+/// A benchmark's cases spread over the ranks.
+#[cfg(feature = "mpi")]
+struct MpiFarm<'a>(&'a czid_optimizers::mpi::MpiEvaluator);
+
+#[cfg(feature = "mpi")]
+impl czid_problems::diagnose::bench::CaseFarm for MpiFarm<'_> {
+    fn run(&self, indices: &[usize], run: &(dyn Fn(usize) -> String + Sync)) -> Vec<String> {
+        self.0.farm(indices, run)
     }
 }

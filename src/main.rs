@@ -167,12 +167,19 @@ fn main() -> ExitCode {
                 spread: cluster.spread(),
             };
             let outcome = run_identify(&problem, &set.sets, &out, &opts);
-            cluster.finish();
+            cluster.finish("evaluations");
             outcome
         }
         Command::Harness(args) => commands::harness::run(&args),
         Command::Diagnose(args) => commands::diagnose::run(&args),
-        Command::GapBench(args) => commands::gap_bench::run(&args),
+        Command::GapBench(args) => {
+            let cluster = Cluster::join();
+            let outcome = commands::gap_bench::run(&args, &cluster);
+            if !cluster.is_worker() {
+                cluster.finish("cases");
+            }
+            outcome
+        }
         Command::Synthesize { truth, out, force } => run_synthesize(&truth, &out, force),
         Command::Compare { problem, optimizers, seeds, budget, target, out, set } => {
             let cluster = Cluster::join();
@@ -181,7 +188,7 @@ fn main() -> ExitCode {
             }
             let opts = CompareOptions { optimizers, seeds, budget, target, spread: cluster.spread() };
             let outcome = run_compare(&problem, &set.sets, &out, &opts);
-            cluster.finish();
+            cluster.finish("evaluations");
             outcome
         }
     };

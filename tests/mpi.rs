@@ -116,3 +116,41 @@ fn compare_on_two_ranks_gives_the_serial_table() {
         std::fs::remove_dir_all(d).ok();
     }
 }
+
+#[test]
+fn gap_bench_cases_spread_over_two_ranks_give_the_serial_cases() {
+    let bin = env!("CARGO_BIN_EXE_czid");
+    let args = |out: &Path| {
+        ["gap-bench", "--cases", "1", "--nulls", "1", "--effects", "machine_compliance", "--out", out.to_str().unwrap()]
+            .map(str::to_string)
+    };
+    let serial = scratch("bench-serial");
+    assert!(Command::new(bin)
+        .args(args(&serial))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+        .status
+        .success());
+    let two = scratch("bench-two");
+    let o = Command::new("mpiexec")
+        .args(["-n", "2", bin])
+        .args(args(&two))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("cases on 2 ranks: rank 0: 1, rank 1: 1"));
+    for name in ["case-dcb-seed1-0000-machine_compliance.json", "case-dcb-seed1-0001-none.json"] {
+        let read = |d: &Path| {
+            let mut v: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(d.join("cases").join(name)).unwrap()).unwrap();
+            v.as_object_mut().unwrap().remove("seconds");
+            v
+        };
+        assert_eq!(read(&two), read(&serial), "{name}");
+    }
+    for d in [serial, two] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}

@@ -18,7 +18,7 @@ fn one_null() -> BenchOptions {
 fn a_resumed_run_reuses_the_cases_already_finished() {
     let dir = scratch("resume");
     let store = CaseStore { dir: OutputDir::create(&dir, false, false).unwrap(), reuse: false };
-    let first = bench::run(&one_null(), Some(&store), &|_, _| {}).unwrap();
+    let first = bench::run(&one_null(), Some(&store), None, &|_, _| {}).unwrap();
     assert_eq!(first.cases.len(), 1);
     assert!(first.cases[0].error.is_none(), "{:?}", first.cases[0].error);
     let files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
@@ -30,13 +30,13 @@ fn a_resumed_run_reuses_the_cases_already_finished() {
     kept["seconds"] = serde_json::json!(-1.0);
     std::fs::write(&files[0], serde_json::to_string(&kept).unwrap()).unwrap();
     let resumed = CaseStore { dir: OutputDir::create(&dir, false, true).unwrap(), reuse: true };
-    let second = bench::run(&one_null(), Some(&resumed), &|_, _| {}).unwrap();
+    let second = bench::run(&one_null(), Some(&resumed), None, &|_, _| {}).unwrap();
     assert_eq!(second.cases[0].seconds, -1.0);
     assert_eq!(second.cases[0].diagnosed, first.cases[0].diagnosed);
 
     // Without reuse the case runs again, with the same draws and the same answer.
     let fresh = CaseStore { dir: OutputDir::create(&dir, true, false).unwrap(), reuse: false };
-    let third = bench::run(&one_null(), Some(&fresh), &|_, _| {}).unwrap();
+    let third = bench::run(&one_null(), Some(&fresh), None, &|_, _| {}).unwrap();
     assert!(third.cases[0].seconds >= 0.0);
     assert_eq!(third.cases[0].truth, first.cases[0].truth);
     assert_eq!(third.cases[0].ranking, first.cases[0].ranking);
@@ -49,6 +49,6 @@ fn families_are_named_and_plant_only_their_own_effects() {
     let e = "enf".parse::<Family>().unwrap_err().to_string();
     assert!(e.contains("unknown family `enf`") && e.contains("dcb, beam"), "{e}");
     let opts = BenchOptions { effects: vec!["steel_hardening".into()], ..one_null() };
-    let e = bench::run(&opts, None, &|_, _| {}).unwrap_err().to_string();
+    let e = bench::run(&opts, None, None, &|_, _| {}).unwrap_err().to_string();
     assert!(e.contains("cannot be planted in the dcb benchmark"), "{e}");
 }

@@ -5,6 +5,7 @@
 //! czid gap-bench --family beam --cases 20 --out out/gap-bench-beam
 //! ```
 
+use crate::cluster::Cluster;
 use czid_core::CzError;
 use czid_problems::diagnose::bench::{self, BenchOptions, CaseStore, Family};
 use czid_problems::output::OutputDir;
@@ -39,8 +40,9 @@ pub struct GapBenchArgs {
     pub resume: bool,
 }
 
-/// Runs the benchmark and writes `bench.json` and `bench.md`.
-pub fn run(args: &GapBenchArgs) -> Result<(), CzError> {
+/// Runs the benchmark and writes `bench.json` and `bench.md`; on several MPI ranks, the cases
+/// are spread over them (rank 0 writes everything).
+pub fn run(args: &GapBenchArgs, cluster: &Cluster) -> Result<(), CzError> {
     let opts = BenchOptions {
         cases: args.cases,
         nulls: args.nulls.unwrap_or(args.cases),
@@ -48,6 +50,11 @@ pub fn run(args: &GapBenchArgs) -> Result<(), CzError> {
         effects: args.effects.clone(),
         family: args.family.parse::<Family>()?,
     };
+    if cluster.is_worker() {
+        let plan = bench::Plan::new(&opts)?;
+        return cluster.serve_tasks(&|i| plan.run_case_json(i));
+    }
+    let farm = cluster.case_farm();
     let dir = OutputDir::create(&args.out, args.force, args.resume)?;
     let store = CaseStore { dir: OutputDir::create(&dir.file("cases"), true, true)?, reuse: args.resume };
     let bar = indicatif::ProgressBar::new(0);
@@ -56,7 +63,7 @@ pub fn run(args: &GapBenchArgs) -> Result<(), CzError> {
     {
         bar.set_style(style.progress_chars("=> "));
     }
-    let report = bench::run(&opts, Some(&store), &|done, total| {
+    let report = bench::run(&opts, Some(&store), farm.as_deref(), &|done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     })?;

@@ -283,77 +283,149 @@ pub struct CaseStore {
     pub reuse: bool,
 }
 
+/// Where the cases of a benchmark run: this process's threads by default, or spread (e.g. over
+/// MPI ranks, each holding the same [`Plan`]). Result `k` is case `k`'s [`CaseResult`] as JSON.
+pub trait CaseFarm: Sync {
+    /// Runs the cases `indices` (`run(k)` gives case `k`'s JSON) and returns their JSON in order.
+    fn run(&self, indices: &[usize], run: &(dyn Fn(usize) -> String + Sync)) -> Vec<String>;
+}
+
+/// What a benchmark runs: the planted effect of every case, and how to run one.
+pub struct Plan {
+    opts: BenchOptions,
+    library: Library,
+    candidates: Vec<std::sync::Arc<dyn CandidateEffect>>,
+    effects: Vec<String>,
+    /// The planted effect of each case, in case order (`none` for a null case).
+    pub cases: Vec<String>,
+}
+
+impl Plan {
+    /// The plan of `opts` (the same on every rank that builds it).
+    pub fn new(opts: &BenchOptions) -> Result<Plan> {
+        let library = Library::builtin();
+        let family = opts.family;
+        // Every candidate that applies to the family's model and that it knows how to plant.
+        let sample = family.base_setup(&family.draw(&mut ChaCha8Rng::seed_from_u64(0)).truth, None)?;
+        let offered = library.names(&sample);
+        if let Some(unknown) = opts.effects.iter().find(|e| !offered.contains(e)) {
+            return Err(CzError::config(
+                "--effects",
+                format!(
+                    "`{unknown}` cannot be planted in the {} benchmark; its model's candidates: {}",
+                    family.name(),
+                    offered.join(", ")
+                ),
+            ));
+        }
+        let candidates = library.select(&sample, &opts.effects)?;
+        let known = |c: &dyn CandidateEffect| c.plant(&mut ChaCha8Rng::seed_from_u64(0)).is_some();
+        let effects: Vec<String> = if opts.effects.is_empty() {
+            candidates
+                .iter()
+                .filter(|c| c.applies(&sample) && known(c.as_ref()))
+                .map(|c| c.name().to_string())
+                .collect()
+        } else {
+            for c in &candidates {
+                if !c.applies(&sample) || !known(c.as_ref()) {
+                    return Err(CzError::config(
+                        "--effects",
+                        format!("`{}` cannot be planted in the {} benchmark", c.name(), family.name()),
+                    ));
+                }
+            }
+            opts.effects.clone()
+        };
+        if opts.cases == 0 && opts.nulls == 0 {
+            return Err(CzError::config("gap-bench", "no cases: give --cases and/or --nulls of at least 1"));
+        }
+        let mut cases: Vec<String> = effects.iter().flat_map(|e| std::iter::repeat_n(e.clone(), opts.cases)).collect();
+        cases.extend(std::iter::repeat_n(NONE.to_string(), opts.nulls));
+        Ok(Plan { opts: opts.clone(), library, candidates, effects, cases })
+    }
+
+    /// Runs case `i`.
+    pub fn run_case(&self, i: usize) -> CaseResult {
+        let p = &self.cases[i];
+        let effect = self.candidates.iter().find(|c| c.name() == p).map(|c| c.as_ref());
+        case(i, p, effect, self.opts.seed, self.opts.family, &self.library)
+    }
+
+    /// Runs case `i` and gives its result as JSON (what a [`CaseFarm`] moves).
+    pub fn run_case_json(&self, i: usize) -> String {
+        serde_json::to_string(&self.run_case(i)).unwrap_or_default()
+    }
+}
+
 /// Runs the benchmark; `progress(done, total)` is called as cases finish. With a `store`, each
 /// finished case is kept there, and with `store.reuse` a case already there is not run again:
-/// an interrupted benchmark resumes where it stopped.
+/// an interrupted benchmark resumes where it stopped. With a `farm`, the cases to run go through
+/// it (and progress is told when they are all back).
 pub fn run(
     opts: &BenchOptions,
     store: Option<&CaseStore>,
+    farm: Option<&dyn CaseFarm>,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<BenchReport> {
     let clock = std::time::Instant::now();
-    let library = Library::builtin();
-    let family = opts.family;
-    // Every candidate that applies to the family's model and that it knows how to plant.
-    let sample = family.base_setup(&family.draw(&mut ChaCha8Rng::seed_from_u64(0)).truth, None)?;
-    let offered = library.names(&sample);
-    if let Some(unknown) = opts.effects.iter().find(|e| !offered.contains(e)) {
-        return Err(CzError::config(
-            "--effects",
-            format!(
-                "`{unknown}` cannot be planted in the {} benchmark; its model's candidates: {}",
-                family.name(),
-                offered.join(", ")
-            ),
-        ));
-    }
-    let candidates = library.select(&sample, &opts.effects)?;
-    let known = |c: &dyn CandidateEffect| c.plant(&mut ChaCha8Rng::seed_from_u64(0)).is_some();
-    let effects: Vec<String> = if opts.effects.is_empty() {
-        candidates.iter().filter(|c| c.applies(&sample) && known(c.as_ref())).map(|c| c.name().to_string()).collect()
-    } else {
-        for c in &candidates {
-            if !c.applies(&sample) || !known(c.as_ref()) {
-                return Err(CzError::config(
-                    "--effects",
-                    format!("`{}` cannot be planted in the {} benchmark", c.name(), family.name()),
-                ));
-            }
-        }
-        opts.effects.clone()
-    };
-    if opts.cases == 0 && opts.nulls == 0 {
-        return Err(CzError::config("gap-bench", "no cases: give --cases and/or --nulls of at least 1"));
-    }
-    let mut plan: Vec<String> = effects.iter().flat_map(|e| std::iter::repeat_n(e.clone(), opts.cases)).collect();
-    plan.extend(std::iter::repeat_n(NONE.to_string(), opts.nulls));
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let total = plan.len();
-    let cases: Vec<CaseResult> = plan
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let file = case_file(opts, i, p);
-            let kept = store
+    let plan = Plan::new(opts)?;
+    let total = plan.cases.len();
+    let kept: Vec<Option<CaseResult>> = (0..total)
+        .map(|i| {
+            store
                 .filter(|s| s.reuse)
-                .and_then(|s| std::fs::read_to_string(s.dir.file(&file)).ok())
+                .and_then(|s| std::fs::read_to_string(s.dir.file(&case_file(opts, i, &plan.cases[i]))).ok())
                 .and_then(|text| serde_json::from_str::<CaseResult>(&text).ok())
-                .filter(|c| c.error.is_none());
-            let r = kept.unwrap_or_else(|| {
-                let effect = candidates.iter().find(|c| c.name() == p).map(|c| c.as_ref());
-                let r = case(i, p, effect, opts.seed, family, &library);
-                if let (Some(s), Ok(json)) = (store, serde_json::to_string_pretty(&r)) {
-                    // Losing a kept case only costs its rerun.
-                    let _ = s.dir.write(&file, &json);
-                }
-                r
-            });
-            progress(done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1, total);
-            r
+                .filter(|c| c.error.is_none())
         })
         .collect();
-
-    Ok(summarise(effects, cases, clock.elapsed().as_secs_f64()))
+    let keep = |i: usize, r: &CaseResult| {
+        if let (Some(s), Ok(json)) = (store, serde_json::to_string_pretty(r)) {
+            // Losing a kept case only costs its rerun.
+            let _ = s.dir.write(&case_file(opts, i, &plan.cases[i]), &json);
+        }
+    };
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let cases: Vec<CaseResult> = match farm {
+        None => kept
+            .into_par_iter()
+            .enumerate()
+            .map(|(i, k)| {
+                let r = k.unwrap_or_else(|| {
+                    let r = plan.run_case(i);
+                    keep(i, &r);
+                    r
+                });
+                progress(done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1, total);
+                r
+            })
+            .collect(),
+        Some(farm) => {
+            let todo: Vec<usize> = (0..total).filter(|&i| kept[i].is_none()).collect();
+            let json = farm.run(&todo, &|i| plan.run_case_json(i));
+            let mut fresh = todo.iter().zip(json).map(|(&i, j)| {
+                let r = serde_json::from_str::<CaseResult>(&j)
+                    .map_err(|e| CzError::Simulation(format!("case {i} came back unreadable from its rank: {e}")))?;
+                keep(i, &r);
+                Ok::<_, CzError>((i, r))
+            });
+            let mut out = Vec::with_capacity(total);
+            for (i, k) in kept.into_iter().enumerate() {
+                out.push(match k {
+                    Some(r) => r,
+                    None => {
+                        let (j, r) = fresh.next().expect("one result per case run")?;
+                        debug_assert_eq!(i, j);
+                        r
+                    }
+                });
+            }
+            progress(total, total);
+            out
+        }
+    };
+    Ok(summarise(plan.effects, cases, clock.elapsed().as_secs_f64()))
 }
 
 /// The scores of finished cases: confusion matrix, top-1/top-2 per effect, false alarms, the
