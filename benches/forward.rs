@@ -4,7 +4,11 @@
 //!   default final opening (crack 60 % of the way to the end by beam theory).
 //! * `dcb_hartlen_30mm`: Hartlen's DCB-01 to 30 mm opening, bilinear law (G_Ic = 0.8 N/mm).
 //!
-//! Both with the default discretisation (interface segments, beam elements of a quarter of the
+//! * `dcb_2d_paper_10mm`: the same DCB on the continuum model (`dcb_2d`, 0.1 mm interface
+//!   elements, 4 Gauss points each, band LU) to 10 mm opening: the mesh its convergence check
+//!   accepts (see the book's "Beam or continuum?" chapter).
+//!
+//! The beam cases with the default discretisation (interface segments, beam elements of a quarter of the
 //! interface element where the crack runs) and solver (the window around the crack front); the
 //! forward models chapter of the book lists the measured medians, and `examples/dcb_profile.rs`
 //! runs the same cases for profilers.
@@ -12,6 +16,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use czid_core::ForwardModel;
 use czid_models::dcb::Dcb;
+use czid_models::dcb_2d::Dcb2d;
 use czid_models::laws::{Bilinear, StCzm};
 
 fn forward(c: &mut Criterion) {
@@ -24,6 +29,12 @@ fn forward(c: &mut Criterion) {
     let law = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
     g.bench_function("dcb_hartlen_30mm", |b| b.iter(|| hartlen.simulate(&law).unwrap()));
     g.finish();
+    let mut slow = c.benchmark_group("forward_continuum");
+    slow.sample_size(10);
+    let mut continuum = Dcb2d::paper();
+    continuum.control.max_displacement = Some(10.0);
+    slow.bench_function("dcb_2d_paper_10mm", |b| b.iter(|| continuum.simulate(&t3).unwrap()));
+    slow.finish();
 }
 
 criterion_group!(benches, forward);

@@ -11,6 +11,8 @@ pub mod laws {}
 pub mod custom_law {}
 #[doc = include_str!("src/forward_models.md")]
 pub mod forward_models {}
+#[doc = include_str!("src/beam_or_continuum.md")]
+pub mod beam_or_continuum {}
 #[doc = include_str!("src/frp_beam.md")]
 pub mod frp_beam {}
 #[doc = include_str!("src/optimizers.md")]

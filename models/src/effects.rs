@@ -47,6 +47,17 @@ pub const LARGE_ROTATION: EffectDeclaration = EffectDeclaration {
     typical: None,
 };
 
+/// An initial crack length other than the nominal one.
+pub const CRACK_LENGTH_OFFSET: EffectDeclaration = EffectDeclaration {
+    name: "crack_length_offset",
+    description: "initial crack length different from the nominal one (blunt insert, misread pre-crack)",
+    field: "effects.crack_length_offset",
+    unit: "mm",
+    kind: EffectKind::Size { range: [-5.0, 5.0], null: 0.0 },
+    scope: EffectScope::PerExperiment,
+    typical: Some(Typical { magnitude: [1.0, 4.0], sign: Sign::Either }),
+};
+
 /// The specimen effects of a beam test (the measurement effects are in [`crate::measurement`]).
 const SPECIMEN: [EffectDeclaration; 3] = [
     EffectDeclaration {
@@ -59,15 +70,7 @@ const SPECIMEN: [EffectDeclaration; 3] = [
         // 0.5–2 × h/(2 E22) for coupon arms (h/(2 E22) ≈ 2.2e-4 mm/MPa for Hartlen's specimens).
         typical: Some(Typical { magnitude: [1.1e-4, 4.4e-4], sign: Sign::Positive }),
     },
-    EffectDeclaration {
-        name: "crack_length_offset",
-        description: "initial crack length different from the nominal one (blunt insert, misread pre-crack)",
-        field: "effects.crack_length_offset",
-        unit: "mm",
-        kind: EffectKind::Size { range: [-5.0, 5.0], null: 0.0 },
-        scope: EffectScope::PerExperiment,
-        typical: Some(Typical { magnitude: [1.0, 4.0], sign: Sign::Either }),
-    },
+    CRACK_LENGTH_OFFSET,
     EffectDeclaration {
         name: "shear_compliance",
         description: "more shear deformation of the arms than the nominal G13 gives",

@@ -4,7 +4,9 @@
 //!   (Xu–Needleman) and a bridging (R-curve) law, all behind [`czid_core::CohesiveLaw`].
 
 pub mod beamtest;
+pub mod continuum;
 pub mod dcb;
+pub mod dcb_2d;
 pub mod effects;
 pub mod enf;
 pub mod fe;

@@ -1,0 +1,103 @@
+//! The table of the book's "Beam or continuum?" chapter: the beam model (with and without its
+//! root-rotation effect) against the continuum model on the same specimens and laws, and the
+//! continuum's mesh convergence and solver times.
+//!
+//! Run with `cargo run --release -p czid-models --example beam_or_continuum`.
+
+use czid_core::{columns, CohesiveLaw, ForwardModel, Record};
+use czid_models::continuum::SolverKind;
+use czid_models::dcb::Dcb;
+use czid_models::dcb_2d::Dcb2d;
+use czid_models::laws::{Bilinear, StCzm};
+
+struct Figures {
+    compliance: f64,
+    peak: f64,
+    propagation: f64,
+}
+
+fn figures(r: &Record, at: f64) -> Figures {
+    let p = r.column(columns::LOAD).unwrap();
+    let d = r.column(columns::DISPLACEMENT).unwrap();
+    let i = (1..d.len()).rev().find(|&i| d[i - 1] <= at && at <= d[i]).unwrap_or(d.len() - 1);
+    let propagation = p[i - 1] + (p[i] - p[i - 1]) * (at - d[i - 1]) / (d[i] - d[i - 1]).max(1e-300);
+    Figures { compliance: d[1] / p[1], peak: p.iter().cloned().fold(0.0, f64::max), propagation }
+}
+
+fn row(name: &str, f: &Figures, reference: &Figures) {
+    let pct = |a: f64, b: f64| 100.0 * (a / b - 1.0);
+    println!(
+        "| {name} | {:.5} ({:+.2} %) | {:.3} ({:+.2} %) | {:.3} ({:+.2} %) |",
+        f.compliance,
+        pct(f.compliance, reference.compliance),
+        f.peak,
+        pct(f.peak, reference.peak),
+        f.propagation,
+        pct(f.propagation, reference.propagation)
+    );
+}
+
+fn compare(title: &str, beam: Dcb, continuum: Dcb2d, law: &dyn CohesiveLaw, at: f64) {
+    println!("\n{title} (propagation load at {at} mm opening)\n");
+    println!("| model | initial compliance (mm/N) | peak (N) | propagation load (N) |");
+    println!("|---|---|---|---|");
+    let t = std::time::Instant::now();
+    let (rc, stats) = continuum.simulate_with_stats(law).unwrap();
+    let seconds = t.elapsed().as_secs_f64();
+    let reference = figures(&rc, at);
+    row("continuum (dcb_2d)", &reference, &reference);
+    let base = figures(&beam.simulate(law).unwrap(), at);
+    row("beam (dcb)", &base, &reference);
+    let mut root = beam.clone();
+    root.effects.root_compliance = beam.h / (2.0 * beam.material.e22);
+    match root.simulate(law) {
+        Ok(r) => row("beam + root_compliance = h/(2 E22)", &figures(&r, at), &reference),
+        Err(f) => println!("| beam + root_compliance = h/(2 E22) | failed: {} | | |", f.error),
+    }
+    println!(
+        "\ncontinuum run: {seconds:.2} s, {} unknowns, {} steps, {} factorisations, solver {:.2} s",
+        stats.unknowns, stats.steps, stats.factorisations, stats.solver_seconds
+    );
+}
+
+fn main() {
+    let paper = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap();
+    let mut beam = Dcb::paper();
+    beam.control.max_displacement = Some(6.0);
+    let mut cont = Dcb2d::paper();
+    cont.control.max_displacement = Some(6.0);
+    compare("Paper DCB, Table 3 ST-CZM", beam, cont.clone(), &paper, 5.0);
+
+    let hartlen = Bilinear::bk(1e5, 60.0, 60.0, 0.8, 2.0, 2.0).unwrap();
+    let mut beam = Dcb::hartlen_dcb01();
+    beam.control.max_displacement = Some(12.0);
+    let mut c = Dcb2d::hartlen_dcb01();
+    c.control.max_displacement = Some(12.0);
+    compare("Hartlen DCB-01, bilinear σ = 60 MPa, G_Ic = 0.8 N/mm", beam, c, &hartlen, 10.0);
+
+    println!("\nMesh convergence and solvers (paper DCB to 10 mm opening)\n");
+    println!("| interface element (mm) | interface points | solver | unknowns | stored entries | peak (N) | run (s) | solver (s) |");
+    println!("|---|---|---|---|---|---|---|---|");
+    for (element, points, solver) in [
+        (0.2, 4, SolverKind::Band),
+        (0.1, 0, SolverKind::Band),
+        (0.1, 2, SolverKind::Band),
+        (0.1, 4, SolverKind::Band),
+        (0.1, 4, SolverKind::Sparse),
+        (0.05, 4, SolverKind::Band),
+    ] {
+        let mut m = Dcb2d::paper();
+        m.mesh.interface_element = element;
+        m.mesh.interface_points = points;
+        m.solver = solver;
+        m.control.max_displacement = Some(10.0);
+        let t = std::time::Instant::now();
+        let (r, s) = m.simulate_with_stats(&paper).unwrap();
+        let seconds = t.elapsed().as_secs_f64();
+        let peak = r.column(columns::LOAD).unwrap().iter().cloned().fold(0.0, f64::max);
+        println!(
+            "| {element} | {points} | {solver:?} | {} | {} | {peak:.3} | {seconds:.2} | {:.2} |",
+            s.unknowns, s.stored, s.solver_seconds
+        );
+    }
+}

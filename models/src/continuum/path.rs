@@ -1,0 +1,413 @@
+//! Path following of a continuum problem: Newton under displacement control, switching to
+//! crack-front opening control where a displacement step fails or dissipates more than a crack
+//! advance of a few elements, so the path passes through the snap-backs of an unstable crack (the
+//! applied displacement then falls).
+//!
+//! Opening control (a local arc length, de Borst 1987; the crack-tip control of the beam engine
+//! in spirit, written anew here) prescribes the effective opening `√(⟨g_n⟩² + g_t²)` of the most
+//! opened point that has not failed, the one just ahead of the crack, and solves for the applied
+//! displacement with the unknowns: a bordered Newton system solved with one factorisation and two
+//! right-hand sides. That opening grows monotonically through a snap-back, where both the load and
+//! the applied displacement fall.
+//!
+//! Energies are integrated where they arise: the external work by the trapezoidal rule on the
+//! load–displacement path, the interface's work at every cohesive point by the trapezoidal rule on
+//! its traction–gap path, and the arms' strain energy from their state. The dissipated energy is
+//! the interface's work less the energy its points still store, so the balance `W = U + D` is a
+//! check on the solution, not an identity.
+
+use czid_core::{CohesiveLaw, CzError, LawState};
+use nalgebra::Vector4;
+
+use super::measures::{measure, CrackMeasures};
+use super::problem::{Assembled, ContinuumProblem, Elements};
+use super::solver::System;
+
+/// Settings of a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathSettings {
+    /// Final value of the controlled unknowns (mm).
+    pub target: f64,
+    /// Equally spaced displacements recorded (the output grid).
+    pub outputs: usize,
+    /// Largest energy a displacement-controlled step may dissipate before the path switches to
+    /// opening control (N·mm, in the mesh's share).
+    pub max_dissipation: f64,
+    /// Largest opening increment of an opening-controlled step (mm).
+    pub max_opening_step: f64,
+    /// Newton iterations before a step is cut.
+    pub max_iterations: usize,
+    /// Relative residual tolerance.
+    pub tolerance: f64,
+    /// Damage from which a point counts as debonded.
+    pub damage_threshold: f64,
+    /// Where the crack starts (mm).
+    pub crack_origin: f64,
+    /// Stop once the crack tip passes this position (mm).
+    pub stop_tip: f64,
+}
+
+/// One recorded state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Row {
+    /// Value of the controlled unknowns (mm).
+    pub control: f64,
+    /// Their summed reaction (N).
+    pub reaction: f64,
+    /// Crack measures.
+    pub crack: CrackMeasures,
+    /// External work (N·mm).
+    pub external_work: f64,
+    /// Strain energy of the arms plus energy stored in the interface (N·mm).
+    pub elastic_energy: f64,
+    /// Energy dissipated at the cohesive points (N·mm).
+    pub dissipated_energy: f64,
+}
+
+/// Statistics of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Converged steps.
+    pub steps: usize,
+    /// Factorisations.
+    pub factorisations: usize,
+    /// Unknowns.
+    pub unknowns: usize,
+    /// Stored matrix entries (band or sparse pattern).
+    pub stored: usize,
+    /// Seconds spent factorising and solving.
+    pub solver_seconds: f64,
+}
+
+/// A run that stopped early: why, and the rows before.
+#[derive(Debug)]
+pub struct Failure {
+    /// Why.
+    pub error: CzError,
+    /// Converged rows.
+    pub rows: Vec<Row>,
+}
+
+/// The committed state of the path.
+#[derive(Clone)]
+struct State {
+    u: Vec<f64>,
+    delta: f64,
+    reaction: f64,
+    laws: Vec<LawState>,
+    gaps: Vec<czid_core::Gap>,
+    tractions: Vec<nalgebra::Vector2<f64>>,
+    work: Vec<f64>,
+    bubbles: Vec<Vector4<f64>>,
+    external: f64,
+}
+
+struct Evaluation {
+    assembled: Assembled,
+    reaction: f64,
+    norm: f64,
+    constraint: f64,
+}
+
+#[derive(Clone, Copy)]
+enum Control {
+    /// The controlled unknowns at this value (mm).
+    Displacement(f64),
+    /// The effective opening of cohesive point `point` at `target` (mm).
+    Opening { point: usize, target: f64 },
+}
+
+struct Solver<'a> {
+    p: &'a ContinuumProblem,
+    law: &'a dyn CohesiveLaw,
+    elements: Elements,
+    system: System,
+    held: Vec<bool>,
+    stats: Stats,
+    settings: &'a PathSettings,
+}
+
+/// Follows the path of `p` with `law` to `settings.target`.
+pub fn run(p: &ContinuumProblem, law: &dyn CohesiveLaw, settings: &PathSettings) -> Result<(Vec<Row>, Stats), Failure> {
+    let n = p.unknowns();
+    let mut held = vec![false; n];
+    for &d in p.fixed.iter().chain(&p.control) {
+        held[d] = true;
+    }
+    let system = p.system();
+    let stats = Stats { unknowns: n, stored: system.stored(), ..Default::default() };
+    let mut s = Solver { p, law, elements: p.elements(), system, held, stats, settings };
+    let m = p.cohesive.len();
+    let ne = p.grid.elements().len();
+    let mut state = State {
+        u: vec![0.0; n],
+        delta: 0.0,
+        reaction: 0.0,
+        laws: vec![law.initial_state(); m],
+        gaps: vec![czid_core::Gap::zeros(); m],
+        tractions: vec![nalgebra::Vector2::zeros(); m],
+        work: vec![0.0; m],
+        bubbles: vec![Vector4::zeros(); if p.large { ne } else { 0 }],
+        external: 0.0,
+    };
+    let mut rows = vec![s.row(&state)];
+    let grid = settings.target / settings.outputs as f64;
+    let min_step = grid * 1e-4;
+    let mut step = grid;
+    let mut opening_step = settings.max_opening_step;
+    let mut by_opening = false;
+    let fail = |rows: Vec<Row>, why: String| Failure { error: CzError::Simulation(why), rows };
+    while state.delta < settings.target * (1.0 - 1e-12) {
+        if rows.last().is_some_and(|r| r.crack.tip >= settings.stop_tip) {
+            break;
+        }
+        if !by_opening {
+            // The next point of the output grid, or a cut step towards it.
+            let next_grid = ((state.delta / grid + 1e-9).floor() + 1.0) * grid;
+            let to = (state.delta + step).min(next_grid).min(settings.target);
+            match s.step(&state, Control::Displacement(to)) {
+                Ok(next) => {
+                    let released = s.row(&next).dissipated_energy - rows.last().map_or(0.0, |r| r.dissipated_energy);
+                    if released > settings.max_dissipation {
+                        by_opening = true;
+                        opening_step = 0.05 * settings.max_opening_step;
+                        continue;
+                    }
+                    state = next;
+                    rows.push(s.row(&state));
+                    step = (step * 2.0).min(grid);
+                }
+                // Two cuts without convergence: the load point cannot lead (a snap-back, or a
+                // point cycling on its law's kink), the crack front can.
+                Err(_) if step > grid / 20.0 && step > min_step => step *= 0.25,
+                Err(_) => {
+                    by_opening = true;
+                    // Small first steps: the path may still be near its peak.
+                    opening_step = 0.05 * settings.max_opening_step;
+                }
+            }
+        } else {
+            let Some((point, now)) = s.front_point(&state) else {
+                break;
+            };
+            let control = Control::Opening { point, target: now + opening_step };
+            let result = s.step(&state, control).and_then(|next| {
+                // A converged state far from the last one (another branch) is not the path.
+                if (next.delta - state.delta).abs() > grid || next.reaction * state.reaction < 0.0 {
+                    Err(format!("the step jumped from {} to {} mm", state.delta, next.delta))
+                } else {
+                    Ok(next)
+                }
+            });
+            match result {
+                Ok(next) => {
+                    state = next;
+                    rows.push(s.row(&state));
+                    opening_step = (opening_step * 1.5).min(settings.max_opening_step);
+                }
+                Err(why) => {
+                    opening_step *= 0.25;
+                    if opening_step < settings.max_opening_step * 1e-4 {
+                        return Err(fail(
+                            rows,
+                            format!("the path could not be followed past {:.4} mm: {why}", state.delta),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Ok((rows, s.stats))
+}
+
+impl Solver<'_> {
+    /// The most opened cohesive point that has not failed, and its effective opening.
+    fn front_point(&self, st: &State) -> Option<(usize, f64)> {
+        st.laws
+            .iter()
+            .zip(&st.gaps)
+            .enumerate()
+            .filter(|(_, (l, _))| l.damage < self.settings.damage_threshold.min(1.0 - 1e-9))
+            .map(|(i, (_, g))| (i, effective(g)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    fn row(&self, st: &State) -> Row {
+        let stored: f64 = self
+            .p
+            .cohesive
+            .iter()
+            .zip(st.gaps.iter().zip(&st.laws))
+            .map(|(pt, (g, l))| self.law.stored_energy(g, l) * pt.area * pt.factor())
+            .sum();
+        let work: f64 = st.work.iter().sum();
+        let bulk = self.bulk_energy(st);
+        let xs: Vec<f64> = self.p.cohesive.iter().map(|p| p.x).collect();
+        let damage: Vec<f64> = st.laws.iter().map(|l| l.damage).collect();
+        Row {
+            control: st.delta,
+            reaction: st.reaction,
+            crack: measure(&xs, &damage, self.settings.damage_threshold, self.settings.crack_origin),
+            external_work: st.external,
+            elastic_energy: bulk + stored + self.p.contact_energy(&st.u),
+            dissipated_energy: work - stored,
+        }
+    }
+
+    fn bulk_energy(&self, st: &State) -> f64 {
+        // Cheap next to a step: one assembly without the tangent.
+        self.p.assemble(&self.elements, self.law, &st.u, &st.laws, &st.bubbles, None).bulk_energy
+    }
+
+    /// One step from `st` under `control`; the converged state, or why Newton failed.
+    ///
+    /// Newton with a backtracking line search on the residual: where a cohesive point sits on the
+    /// kink of its law (the peak, the onset of damage), plain Newton can cycle between loading and
+    /// unloading it; halving the update until the residual falls breaks the cycle.
+    fn step(&mut self, st: &State, control: Control) -> Result<State, String> {
+        let n = self.p.unknowns();
+        let mut u = st.u.clone();
+        let mut delta = match control {
+            Control::Displacement(to) => to,
+            Control::Opening { .. } => st.delta,
+        };
+        let p0 = st.reaction;
+        let mut current = self.evaluate(&mut u, delta, st, &control, true);
+        for iteration in 0..self.settings.max_iterations {
+            let Evaluation { assembled: a, reaction, norm, constraint } = current;
+            // The load is the scale of the residual; the reaction of a displacement predictor
+            // (the controlled unknowns moved alone) is not.
+            let scale = p0.abs().max(reaction.abs()).max(1e-9);
+            let converged = iteration > 0
+                && norm <= self.settings.tolerance * scale
+                && match control {
+                    Control::Displacement(_) => true,
+                    Control::Opening { .. } => constraint.abs() <= 1e-9 * self.settings.max_opening_step,
+                };
+            if converged {
+                return Ok(self.commit(st, u, delta, reaction, a));
+            }
+            if !norm.is_finite() {
+                return Err("the residual is not finite".into());
+            }
+            let (du, dd) = self.direction(&a, constraint, &control)?;
+            // Backtracking: the full update first, then halves while the residual grows.
+            // The opening's error weighs as the force that would close it over the step's size.
+            let weight = scale / self.settings.max_opening_step;
+            let merit = |e: &Evaluation| e.norm + e.constraint.abs() * weight;
+            let start = norm + constraint.abs() * weight;
+            let mut alpha = 1.0;
+            loop {
+                let mut trial = u.clone();
+                for i in 0..n {
+                    trial[i] += alpha * du[i];
+                }
+                let td = delta + alpha * dd;
+                let e = self.evaluate(&mut trial, td, st, &control, false);
+                if merit(&e) < start || alpha < 0.1 || iteration == 0 {
+                    u = trial;
+                    delta = td;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            current = self.evaluate(&mut u, delta, st, &control, true);
+        }
+        Err(format!("Newton did not converge in {} iterations", self.settings.max_iterations))
+    }
+
+    /// Residual (and tangent, when `tangent`) at `u` with the controlled unknowns at `delta`.
+    fn evaluate(&mut self, u: &mut [f64], delta: f64, st: &State, control: &Control, tangent: bool) -> Evaluation {
+        for &c in &self.p.control {
+            u[c] = delta;
+        }
+        let a = if tangent {
+            self.p.assemble(&self.elements, self.law, u, &st.laws, &st.bubbles, Some(&mut self.system))
+        } else {
+            self.p.assemble(&self.elements, self.law, u, &st.laws, &st.bubbles, None)
+        };
+        let reaction: f64 = self.p.control.iter().map(|&c| a.force[c]).sum();
+        let norm = (0..a.force.len()).filter(|&i| !self.held[i]).map(|i| a.force[i] * a.force[i]).sum::<f64>().sqrt();
+        let constraint = match control {
+            Control::Displacement(_) => 0.0,
+            Control::Opening { point, target } => effective(&a.interface.gaps[*point]) - target,
+        };
+        Evaluation { assembled: a, reaction, norm, constraint }
+    }
+
+    /// The Newton update `(du, dδ)` from the assembled tangent.
+    fn direction(&mut self, a: &Assembled, constraint: f64, control: &Control) -> Result<(Vec<f64>, f64), String> {
+        let n = self.p.unknowns();
+        // Column and row of the control (summed over the controlled unknowns), before the held
+        // rows and columns are replaced by the identity.
+        let mut col = vec![0.0; n];
+        for &c in &self.p.control {
+            for i in self.system.neighbours(c) {
+                col[i] += self.system.get(i, c);
+            }
+        }
+        for i in 0..n {
+            if self.held[i] {
+                self.system.set_identity(i);
+                col[i] = 0.0;
+            }
+        }
+        let t = std::time::Instant::now();
+        self.system.factor()?;
+        let mut ra: Vec<f64> = (0..n).map(|i| if self.held[i] { 0.0 } else { -a.force[i] }).collect();
+        let mut rb: Vec<f64> = col.iter().map(|v| -v).collect();
+        self.system.solve(&mut ra);
+        self.system.solve(&mut rb);
+        self.stats.factorisations += 1;
+        self.stats.solver_seconds += t.elapsed().as_secs_f64();
+        // Under displacement control the controlled unknowns already sit at their new value in
+        // the residual, so the free ones follow from it alone.
+        let dd = match control {
+            Control::Displacement(_) => 0.0,
+            Control::Opening { point, .. } => {
+                // g(u) = |gap(u)| − target, linearised with du = a + b dδ (g does not depend on δ
+                // directly: the controlled unknowns are not on the interface).
+                let c = self.p.cohesive[*point].opening_gradient(&a.interface.gaps[*point]);
+                let dot =
+                    |v: &[f64]| -> f64 { c.iter().map(|&(i, w)| if self.held[i] { 0.0 } else { w * v[i] }).sum() };
+                let denom = dot(&rb);
+                if denom.abs() < 1e-300 {
+                    return Err("the controlled opening does not respond to the load".into());
+                }
+                (-constraint - dot(&ra)) / denom
+            }
+        };
+        let du = (0..n).map(|i| if self.held[i] { 0.0 } else { ra[i] + rb[i] * dd }).collect();
+        Ok((du, dd))
+    }
+
+    fn commit(&mut self, st: &State, u: Vec<f64>, delta: f64, reaction: f64, a: Assembled) -> State {
+        self.stats.steps += 1;
+        let work: Vec<f64> = self
+            .p
+            .cohesive
+            .iter()
+            .enumerate()
+            .map(|(i, pt)| {
+                let dg = a.interface.gaps[i] - st.gaps[i];
+                st.work[i] + 0.5 * (st.tractions[i] + a.interface.tractions[i]).dot(&dg) * pt.area * pt.factor()
+            })
+            .collect();
+        State {
+            external: st.external + 0.5 * (st.reaction + reaction) * (delta - st.delta),
+            u,
+            delta,
+            reaction,
+            laws: a.interface.states,
+            gaps: a.interface.gaps,
+            tractions: a.interface.tractions,
+            work,
+            bubbles: if self.p.large { a.bubbles } else { Vec::new() },
+        }
+    }
+}
+
+/// Effective opening `√(⟨g_n⟩² + g_t²)` (mm).
+fn effective(g: &czid_core::Gap) -> f64 {
+    (g[0].max(0.0).powi(2) + g[1] * g[1]).sqrt()
+}

@@ -1,0 +1,148 @@
+//! What the continuum test models share: mesh settings, switchable effects, and the conversion
+//! of path rows into a record with the beam models' columns.
+
+use czid_core::error::require_non_negative;
+use czid_core::{CzError, EffectDeclaration, Record, Result};
+use serde::{Deserialize, Serialize};
+
+use super::path::Row;
+use crate::beamtest::{self, RowScale};
+
+/// Element sizes of a continuum model (mm).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContinuumMesh {
+    /// Element length along the crack path, where the crack can run (mm): one cohesive point per
+    /// node, so this is also the cohesive points' spacing.
+    pub interface_element: f64,
+    /// Largest element length elsewhere along the arms (mm); elements grow geometrically (×1.2)
+    /// from `interface_element` at the crack front to it.
+    pub arm_element: f64,
+    /// Elements through the thickness of each arm.
+    pub thickness_elements: usize,
+    /// Gauss points per interface element (1–4), or 0 for nodal (Newton–Cotes) integration; see
+    /// [`crate::continuum::interface`].
+    pub interface_points: usize,
+}
+
+impl Default for ContinuumMesh {
+    fn default() -> Self {
+        ContinuumMesh { interface_element: 0.1, arm_element: 1.0, thickness_elements: 4, interface_points: 4 }
+    }
+}
+
+/// Largest number of nodes a continuum mesh may have (about 0.5 GB with the band LU).
+pub const MAX_NODES: usize = 2_000_000;
+
+impl ContinuumMesh {
+    /// Checks the sizes.
+    pub fn validate(&self, owner: &str) -> Result<()> {
+        beamtest::positive(owner, "mesh.interface_element", self.interface_element)?;
+        beamtest::positive(owner, "mesh.arm_element", self.arm_element)?;
+        if self.interface_element < beamtest::MIN_ELEMENT {
+            return Err(CzError::invalid(
+                owner,
+                "mesh.interface_element",
+                self.interface_element,
+                format!("is below {} mm, far finer than any cohesive zone needs", beamtest::MIN_ELEMENT),
+            ));
+        }
+        if !(1..=64).contains(&self.thickness_elements) {
+            return Err(CzError::invalid(
+                owner,
+                "mesh.thickness_elements",
+                self.thickness_elements as f64,
+                "must be between 1 and 64",
+            ));
+        }
+        if self.interface_points > 4 {
+            return Err(CzError::invalid(
+                owner,
+                "mesh.interface_points",
+                self.interface_points as f64,
+                "must be 0 (nodal integration) or 1–4 Gauss points",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Refuses a mesh of more than [`MAX_NODES`] nodes over `length` mm and `layers` arms.
+    pub fn check_size(&self, owner: &str, length: f64, layers: usize) -> Result<()> {
+        let nodes = (length / self.interface_element + 1.0) * ((self.thickness_elements + 1) * layers) as f64;
+        if nodes > MAX_NODES as f64 {
+            return Err(CzError::invalid(
+                owner,
+                "mesh.interface_element",
+                self.interface_element,
+                format!("gives about {nodes:.3e} nodes (at most {MAX_NODES}): use a coarser mesh"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Optional physics of a continuum test model; the default is the base model. The beam models'
+/// `root_compliance` and `shear_compliance` have no counterpart: the continuum resolves both.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContinuumEffects {
+    /// Compliance of the machine and load train (mm/N): the recorded displacement is
+    /// `δ + C_m P`. 0: rigid machine.
+    pub machine_compliance: f64,
+    /// Added to the nominal initial crack length (mm). 0: nominal.
+    pub crack_length_offset: f64,
+    /// Seating offset (mm): an unloaded toe, then every displacement shifted. 0: none.
+    pub displacement_offset: f64,
+    /// Large displacements (total Lagrangian) instead of small strain.
+    pub large_rotation: bool,
+}
+
+impl ContinuumEffects {
+    /// Checks the values.
+    pub fn validate(&self, owner: &str) -> Result<()> {
+        require_non_negative(owner, "effects.machine_compliance", self.machine_compliance)?;
+        for (name, v) in [
+            ("effects.crack_length_offset", self.crack_length_offset),
+            ("effects.displacement_offset", self.displacement_offset),
+        ] {
+            if !v.is_finite() {
+                return Err(CzError::invalid(owner, name, v, "must be finite"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The effects a continuum model declares (`large`: whether it offers large displacements).
+    pub fn declarations(large: bool) -> Vec<EffectDeclaration> {
+        use crate::measurement::{DISPLACEMENT_OFFSET, MACHINE_COMPLIANCE};
+        let mut out = Vec::new();
+        if large {
+            out.push(crate::effects::LARGE_ROTATION);
+        }
+        out.extend([MACHINE_COMPLIANCE, crate::effects::CRACK_LENGTH_OFFSET, DISPLACEMENT_OFFSET]);
+        out
+    }
+}
+
+/// The record of `rows` scaled into the specimen's displacement, load and energies.
+pub fn record(rows: &[Row], s: &RowScale) -> Record {
+    let mut rec = beamtest::new_record();
+    if s.offset > 0.0 {
+        let tip = rows.first().map_or(0.0, |r| r.crack.tip);
+        rec.push(&[0.0, 0.0, 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
+    }
+    for r in rows {
+        let p = s.load * r.reaction;
+        rec.push(&[
+            s.displacement * r.control + s.compliance * p + s.offset,
+            p,
+            r.crack.debonded,
+            r.crack.process_zone,
+            r.crack.tip,
+            s.energy * r.external_work,
+            s.energy * r.elastic_energy,
+            s.energy * r.dissipated_energy,
+        ]);
+    }
+    rec
+}

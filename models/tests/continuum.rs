@@ -1,0 +1,182 @@
+//! The continuum DCB against closed forms and published values it does not share code with:
+//! Timoshenko's cantilever, corrected beam theory (Williams / Hashemi), NASA CompDam's DCB
+//! example; energy balance and mesh convergence.
+
+use czid_core::{columns, CohesiveLaw, ForwardModel, Record};
+use czid_models::beamtest::Material;
+use czid_models::continuum::grid::{rows, uniform, Grid};
+use czid_models::continuum::{elasticity, path, ContinuumProblem, PathSettings, SolverKind};
+use czid_models::dcb_2d::Dcb2d;
+use czid_models::laws::{Bilinear, StCzm};
+
+fn paper_law() -> StCzm {
+    StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap()
+}
+
+fn peak(r: &Record) -> (f64, f64) {
+    let p = r.column(columns::LOAD).unwrap();
+    let d = r.column(columns::DISPLACEMENT).unwrap();
+    let i = (0..p.len()).max_by(|&a, &b| p[a].total_cmp(&p[b])).unwrap();
+    (p[i], d[i])
+}
+
+/// Corrected beam theory: `G = P² (a + χh)² / (b E I)` at `G = G_Ic`, with Williams' / Hashemi's
+/// `χ = √(E11/(11 G13) (3 − 2 (Γ/(1+Γ))²))`, `Γ = 1.18 √(E11 E22) / G13`.
+fn cbt_critical_load(m: &Material, b: f64, h: f64, a: f64, gc: f64) -> f64 {
+    let gamma = 1.18 * (m.e11 * m.e22).sqrt() / m.g13;
+    let chi = ((m.e11 / (11.0 * m.g13)) * (3.0 - 2.0 * (gamma / (1.0 + gamma)).powi(2))).sqrt();
+    let ei = m.e11 * b * h.powi(3) / 12.0;
+    (b * ei * gc).sqrt() / (a + chi * h)
+}
+
+/// Load on corrected beam theory's propagation branch at opening `delta`: `δ = 2 P (a+χh)³ /
+/// (3 E I)` with `P = √(b E I G_c) / (a + χh)`.
+fn cbt_propagation_load(m: &Material, b: f64, h: f64, gc: f64, delta: f64) -> f64 {
+    let ei = m.e11 * b * h.powi(3) / 12.0;
+    // a_eff³ · 2/(3EI) · √(bEI Gc)/a_eff = δ  ⇒  a_eff² = 3 EI δ / (2 √(bEI Gc)).
+    let a_eff = (3.0 * ei * delta / (2.0 * (b * ei * gc).sqrt())).sqrt();
+    (b * ei * gc).sqrt() / a_eff
+}
+
+/// Load at opening `x` on the last stretch of the path reaching it (linear between rows).
+fn load_at(d: &[f64], p: &[f64], x: f64) -> f64 {
+    let i = (1..d.len()).rev().find(|&i| d[i - 1] <= x && x <= d[i]).expect("the path reaches x");
+    p[i - 1] + (p[i] - p[i - 1]) * (x - d[i - 1]) / (d[i] - d[i - 1])
+}
+
+#[test]
+fn cantilever_tip_deflection_matches_timoshenko() {
+    // The paper's arm as a cantilever: 50 mm long, 1.62 mm thick, 20 mm wide, clamped at x = 50,
+    // pulled at the mid-thickness node of its free end as the DCB's hinge is.
+    let m = Dcb2d::paper().material;
+    let (l, h, b) = (50.0, 1.62, 20.0);
+    let grid = Grid::new(uniform(0.0, l, 0.5), vec![rows(0.0, h, 4)], b);
+    let nc = grid.xs.len();
+    let clamp: Vec<usize> = (0..5)
+        .flat_map(|r| {
+            let n = grid.node(0, nc - 1, r);
+            [2 * n, 2 * n + 1]
+        })
+        .collect();
+    let tip = grid.node(0, 0, 2);
+    let p = ContinuumProblem {
+        grid,
+        stiffness: elasticity::plane_stress(&m, "test").unwrap(),
+        large: false,
+        cohesive: Vec::new(),
+        contact: Vec::new(),
+        contact_stiffness: 0.0,
+        fixed: clamp,
+        control: vec![2 * tip + 1],
+        solver: SolverKind::Band,
+    };
+    let settings = PathSettings {
+        target: 1.0,
+        outputs: 1,
+        max_dissipation: 1.0,
+        max_opening_step: 1.0,
+        max_iterations: 5,
+        tolerance: 1e-10,
+        damage_threshold: 1.0,
+        crack_origin: 0.0,
+        stop_tip: f64::INFINITY,
+    };
+    let law = paper_law();
+    let (rows, _) = path::run(&p, &law, &settings).unwrap();
+    let last = rows.last().unwrap();
+    let compliance = last.control / last.reaction;
+    let i = b * h.powi(3) / 12.0;
+    let timoshenko = l.powi(3) / (3.0 * m.e11 * i) + l / (5.0 / 6.0 * m.g13 * b * h);
+    let rel = compliance / timoshenko - 1.0;
+    eprintln!("cantilever: {compliance:.6} mm/N vs Timoshenko {timoshenko:.6} ({:+.3} %)", 100.0 * rel);
+    assert!(rel.abs() < 0.005, "tip compliance {compliance} mm/N vs Timoshenko {timoshenko}: {:.3} %", 100.0 * rel);
+}
+
+#[test]
+fn paper_dcb_peak_matches_corrected_beam_theory_and_energy_balances() {
+    let dcb = Dcb2d::paper();
+    let law = paper_law();
+    let mut run = dcb.clone();
+    run.control.max_displacement = Some(6.0);
+    let r = run.simulate(&law).unwrap();
+    let (p, _) = peak(&r);
+    let cbt = cbt_critical_load(&dcb.material, dcb.width, dcb.h, dcb.a0, law.fracture_energy()[0]);
+    eprintln!("paper DCB: peak {p:.3} N vs corrected beam theory {cbt:.3} N");
+    assert!((p / cbt - 1.0).abs() < 0.015, "peak {p} N vs corrected beam theory {cbt} N");
+    // Energy balance at every recorded state: the external work against the arms' strain energy
+    // and the interface's work, each integrated where it arises.
+    let w = r.column(columns::EXTERNAL_WORK).unwrap();
+    let u = r.column(columns::ELASTIC_ENERGY).unwrap();
+    let d = r.column(columns::DISSIPATED_ENERGY).unwrap();
+    for i in 1..w.len() {
+        assert!((w[i] - u[i] - d[i]).abs() <= 0.005 * w[i], "row {i}: W {} U {} D {}", w[i], u[i], d[i]);
+    }
+    // The dissipated energy is G_Ic over the new crack, plus part of the process zone's.
+    let grown = r.column(columns::DEBONDED_LENGTH).unwrap();
+    let zone = r.column(columns::PROCESS_ZONE_LENGTH).unwrap();
+    let k = w.len() - 1;
+    let gb = law.fracture_energy()[0] * dcb.width;
+    assert!(grown[k] > 10.0, "the crack grew {} mm", grown[k]);
+    assert!(d[k] >= gb * grown[k] && d[k] <= gb * (grown[k] + zone[k]), "D {} for {} + {} mm", d[k], grown[k], zone[k]);
+    // Propagation: corrected beam theory's branch at the last opening.
+    let delta = r.column(columns::DISPLACEMENT).unwrap()[k];
+    let load = r.column(columns::LOAD).unwrap()[k];
+    let branch = cbt_propagation_load(&dcb.material, dcb.width, dcb.h, law.fracture_energy()[0], delta);
+    let worst = (1..w.len()).map(|i| ((w[i] - u[i] - d[i]) / w[i]).abs()).fold(0.0, f64::max);
+    eprintln!("paper DCB: {load:.3} N at {delta:.3} mm vs {branch:.3} N; worst energy imbalance {worst:.2e}");
+    assert!((load / branch - 1.0).abs() < 0.03, "load {load} N at {delta} mm vs corrected beam theory {branch} N");
+}
+
+#[test]
+fn hartlen_dcb_with_a_short_process_zone_peaks_at_corrected_beam_theory() {
+    let mut dcb = Dcb2d::hartlen_dcb01();
+    dcb.control.max_displacement = Some(8.0);
+    let law = Bilinear::bk(1e5, 60.0, 60.0, 0.8, 2.0, 2.0).unwrap();
+    let r = dcb.simulate(&law).unwrap();
+    let (p, _) = peak(&r);
+    let cbt = cbt_critical_load(&dcb.material, dcb.width, dcb.h, dcb.a0, 0.8);
+    eprintln!("Hartlen DCB: peak {p:.3} N vs corrected beam theory {cbt:.3} N");
+    assert!((p / cbt - 1.0).abs() < 0.015, "peak {p} N vs corrected beam theory {cbt} N");
+}
+
+#[test]
+fn compdam_dcb_example() {
+    // NASA CompDam_DGD `examples/interlaminar` DCB: peak 8.0 N, 4.38 N at 4.5 mm opening.
+    let dcb = Dcb2d {
+        a0: 50.8,
+        length: 150.0,
+        width: 1.0,
+        h: 3.8,
+        material: Material { e11: 171_420.0, e22: 9_080.0, g13: 5_290.0, nu13: 0.0, plane: Default::default() },
+        mesh: czid_models::continuum::ContinuumMesh { interface_element: 0.2, ..Default::default() },
+        control: czid_models::beamtest::ControlSettings { max_displacement: Some(4.5), ..Default::default() },
+        effects: Default::default(),
+        solver: SolverKind::Band,
+    };
+    let law = Bilinear::bk(1e5, 62.3, 62.3, 0.277, 0.788, 2.0).unwrap();
+    let r = dcb.simulate(&law).unwrap();
+    let (p, _) = peak(&r);
+    assert!((p / 8.0 - 1.0).abs() < 0.03, "peak {p} N vs 8.0 N");
+    let d = r.column(columns::DISPLACEMENT).unwrap();
+    let load = r.column(columns::LOAD).unwrap();
+    let at = load_at(d, load, 4.5);
+    eprintln!("CompDam DCB: peak {p:.3} N (8.0), {at:.3} N at 4.5 mm (4.38)");
+    assert!((at / 4.38 - 1.0).abs() < 0.03, "load at 4.5 mm {at} N vs 4.38 N");
+}
+
+/// The peak on the two finest meshes of the convergence study in the book.
+#[test]
+fn paper_dcb_peak_converges_with_the_mesh() {
+    let law = paper_law();
+    let peaks: Vec<f64> = [0.1, 0.05]
+        .iter()
+        .map(|&e| {
+            let mut dcb = Dcb2d::paper();
+            dcb.mesh.interface_element = e;
+            dcb.control.max_displacement = Some(3.0);
+            peak(&dcb.simulate(&law).unwrap()).0
+        })
+        .collect();
+    eprintln!("paper DCB peaks at 0.1 and 0.05 mm: {peaks:?}");
+    assert!((peaks[0] / peaks[1] - 1.0).abs() < 0.005, "peaks {peaks:?}");
+}
