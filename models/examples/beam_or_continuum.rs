@@ -75,20 +75,64 @@ fn main() {
     c.control.max_displacement = Some(12.0);
     compare("Hartlen DCB-01, bilinear σ = 60 MPa, G_Ic = 0.8 N/mm", beam, c, &hartlen, 10.0);
 
+    // ENF: Hartlen's ENF-03 geometry with a 40 mm crack and a short process zone.
+    let enf_law = Bilinear::bk(1e6, 60.0, 150.0, 0.8, 2.0, 2.0).unwrap();
+    let mut beam = czid_models::enf::Enf::hartlen_enf03();
+    beam.a0 = 40.0;
+    let mut c = czid_models::enf_2d::Enf2d::hartlen_enf03();
+    c.a0 = 40.0;
+    let rc = c.simulate(&enf_law).unwrap();
+    let at = 0.98 * rc.column(columns::DISPLACEMENT).unwrap().last().unwrap();
+    println!(
+        "\nHartlen ENF geometry, a0 = 40 mm, bilinear τ = 150 MPa, G_IIc = 2 N/mm (load at {at:.2} mm deflection)\n"
+    );
+    println!("| model | initial compliance (mm/N) | peak (N) | load (N) |");
+    println!("|---|---|---|---|");
+    let reference = figures(&rc, at);
+    row("continuum (enf_2d)", &reference, &reference);
+    row("beam (enf)", &figures(&beam.simulate(&enf_law).unwrap(), at), &reference);
+    let mut root = beam.clone();
+    root.effects.root_compliance = beam.h / (2.0 * beam.material.e22);
+    match root.simulate(&enf_law) {
+        Ok(r) => row("beam + root_compliance = h/(2 E22)", &figures(&r, at), &reference),
+        Err(f) => println!("| beam + root_compliance = h/(2 E22) | failed: {} | | |", f.error),
+    }
+
+    // Large displacements: Hartlen's DCB to 30 mm opening (δ/a reaches 0.3).
+    let mut beam = Dcb::hartlen_dcb01();
+    beam.effects.large_rotation = true;
+    let mut c = Dcb2d::hartlen_dcb01();
+    c.effects.large_rotation = true;
+    println!("\nHartlen DCB-01 to 30 mm, large displacements in both models (load at 25 mm opening)\n");
+    println!("| model | initial compliance (mm/N) | peak (N) | load (N) |");
+    println!("|---|---|---|---|");
+    let t = std::time::Instant::now();
+    let rc = c.simulate(&hartlen).unwrap();
+    let seconds = t.elapsed().as_secs_f64();
+    let reference = figures(&rc, 25.0);
+    row("continuum, total Lagrangian", &reference, &reference);
+    row("beam, co-rotational", &figures(&beam.simulate(&hartlen).unwrap(), 25.0), &reference);
+    let mut small = Dcb2d::hartlen_dcb01();
+    small.effects.large_rotation = false;
+    row("continuum, small strain", &figures(&small.simulate(&hartlen).unwrap(), 25.0), &reference);
+    println!("\ncontinuum large-displacement run: {seconds:.2} s");
+
     println!("\nMesh convergence and solvers (paper DCB to 10 mm opening)\n");
-    println!("| interface element (mm) | interface points | solver | unknowns | stored entries | peak (N) | run (s) | solver (s) |");
-    println!("|---|---|---|---|---|---|---|---|");
-    for (element, points, solver) in [
-        (0.2, 4, SolverKind::Band),
-        (0.1, 0, SolverKind::Band),
-        (0.1, 2, SolverKind::Band),
-        (0.1, 4, SolverKind::Band),
-        (0.1, 4, SolverKind::Sparse),
-        (0.05, 4, SolverKind::Band),
+    println!("| interface element (mm) | interface points | elements through the arm | solver | unknowns | stored entries | peak (N) | run (s) | solver (s) |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for (element, points, solver, thickness) in [
+        (0.2, 4, SolverKind::Band, 4),
+        (0.1, 0, SolverKind::Band, 4),
+        (0.1, 2, SolverKind::Band, 4),
+        (0.1, 4, SolverKind::Band, 4),
+        (0.1, 4, SolverKind::Sparse, 4),
+        (0.1, 4, SolverKind::Band, 8),
+        (0.05, 4, SolverKind::Band, 4),
     ] {
         let mut m = Dcb2d::paper();
         m.mesh.interface_element = element;
         m.mesh.interface_points = points;
+        m.mesh.thickness_elements = thickness;
         m.solver = solver;
         m.control.max_displacement = Some(10.0);
         let t = std::time::Instant::now();
@@ -96,7 +140,7 @@ fn main() {
         let seconds = t.elapsed().as_secs_f64();
         let peak = r.column(columns::LOAD).unwrap().iter().cloned().fold(0.0, f64::max);
         println!(
-            "| {element} | {points} | {solver:?} | {} | {} | {peak:.3} | {seconds:.2} | {:.2} |",
+            "| {element} | {points} | {thickness} | {solver:?} | {} | {} | {peak:.3} | {seconds:.2} | {:.2} |",
             s.unknowns, s.stored, s.solver_seconds
         );
     }

@@ -100,6 +100,46 @@ impl Dcb2d {
         }
     }
 
+    /// The continuum model of the specimen a beam DCB describes, with the beam's effects carried
+    /// over: the measurement's (machine compliance, displacement offset), the crack-length offset
+    /// and large rotations as they are; the beam's extra compliances as the material change they
+    /// stand for: `root_compliance c` lowers the through-thickness modulus so that the arm's
+    /// compliance `h/(2 E22)` grows by `c`, `shear_compliance s` lowers `G13` to
+    /// `1/(1/G13 + s)`. The mesh keeps the beam's interface element (4 Gauss points in each).
+    pub fn from_beam(beam: &crate::dcb::Dcb) -> Result<Dcb2d> {
+        const FROM: &str = "model dcb (as a continuum)";
+        if beam.symmetry != crate::dcb::Symmetry::Half || beam.h_lower.is_some_and(|hl| hl != beam.h) {
+            return Err(CzError::invalid(FROM, "symmetry", f64::NAN, "only equal arms have a continuum counterpart"));
+        }
+        let fx = &beam.effects;
+        let mut material = beam.material.clone();
+        // Switched off, an effect leaves the material as it is, bit for bit.
+        if fx.root_compliance > 0.0 {
+            material.e22 = 1.0 / (1.0 / material.e22 + 2.0 * fx.root_compliance / beam.h);
+        }
+        material.g13 = fx.shear_modulus(material.g13);
+        Ok(Dcb2d {
+            a0: beam.a0,
+            length: beam.length,
+            width: beam.width,
+            h: beam.h,
+            material,
+            mesh: ContinuumMesh {
+                interface_element: beam.mesh.interface_element,
+                arm_element: beam.mesh.arm_element.max(beam.mesh.interface_element),
+                ..Default::default()
+            },
+            control: beam.control.clone(),
+            effects: ContinuumEffects {
+                machine_compliance: fx.machine_compliance,
+                crack_length_offset: fx.crack_length_offset,
+                displacement_offset: fx.displacement_offset,
+                large_rotation: fx.large_rotation,
+            },
+            solver: SolverKind::default(),
+        })
+    }
+
     /// Checks the configuration, naming the first invalid field.
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [("a0", self.a0), ("length", self.length), ("width", self.width), ("h", self.h)] {
@@ -178,7 +218,7 @@ impl Dcb2d {
             contact: Vec::new(),
             contact_stiffness: 0.0,
             fixed: vec![2 * hinge],
-            control: vec![control],
+            control: vec![(control, 1.0)],
             solver: self.solver,
         };
         Ok((p, scale))

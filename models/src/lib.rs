@@ -9,6 +9,7 @@ pub mod dcb;
 pub mod dcb_2d;
 pub mod effects;
 pub mod enf;
+pub mod enf_2d;
 pub mod fe;
 pub mod frp;
 pub mod laws;

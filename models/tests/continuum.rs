@@ -67,7 +67,7 @@ fn cantilever_tip_deflection_matches_timoshenko() {
         contact: Vec::new(),
         contact_stiffness: 0.0,
         fixed: clamp,
-        control: vec![2 * tip + 1],
+        control: vec![(2 * tip + 1, 1.0)],
         solver: SolverKind::Band,
     };
     let settings = PathSettings {
@@ -179,4 +179,112 @@ fn paper_dcb_peak_converges_with_the_mesh() {
         .collect();
     eprintln!("paper DCB peaks at 0.1 and 0.05 mm: {peaks:?}");
     assert!((peaks[0] / peaks[1] - 1.0).abs() < 0.005, "peaks {peaks:?}");
+}
+
+/// Wang & Williams' crack-tip correction of the ENF, `a + 0.42 χ h` (χ as corrected beam
+/// theory's for the DCB).
+fn ww_crack(m: &Material, h: f64, a: f64) -> f64 {
+    let gamma = 1.18 * (m.e11 * m.e22).sqrt() / m.g13;
+    let chi = ((m.e11 / (11.0 * m.g13)) * (3.0 - 2.0 * (gamma / (1.0 + gamma)).powi(2))).sqrt();
+    a + 0.42 * chi * h
+}
+
+/// ENF compliance with shear, `(3a³ + 2L³)/(8 E b h³) + 3L/(10 G13 b h)`.
+fn enf_compliance(m: &Material, b: f64, h: f64, l: f64, a: f64) -> f64 {
+    (3.0 * a.powi(3) + 2.0 * l.powi(3)) / (8.0 * m.e11 * b * h.powi(3)) + 3.0 * l / (10.0 * m.g13 * b * h)
+}
+
+fn initial_compliance(r: &Record) -> f64 {
+    r.column(columns::DISPLACEMENT).unwrap()[1] / r.column(columns::LOAD).unwrap()[1]
+}
+
+#[test]
+fn enf_compliance_matches_timoshenko_uncracked_and_wang_williams_cracked() {
+    use czid_models::enf_2d::Enf2d;
+    // A short process zone (τ = 150 MPa) and a stiff penalty: the elastic response is the arms'.
+    let law = Bilinear::bk(1e6, 60.0, 150.0, 0.8, 2.0, 2.0).unwrap();
+    let mut enf = Enf2d::hartlen_enf03();
+    let (m, b, h, l) = (enf.material.clone(), enf.width, enf.h, enf.half_span);
+    enf.control.max_displacement = Some(0.5);
+    enf.control.output_points = 2;
+    // Nearly uncracked (a0 = 1 mm): three-point bending of a Timoshenko beam 2h deep.
+    enf.a0 = 1.0;
+    let c = initial_compliance(&enf.simulate(&law).unwrap());
+    let timoshenko = enf_compliance(&m, b, h, l, 1.0);
+    eprintln!("ENF a0 = 1 mm: compliance {c:.6} mm/N vs Timoshenko {timoshenko:.6}");
+    assert!((c / timoshenko - 1.0).abs() < 0.01);
+    // Cracked (a0 = 40 mm): beam theory leaves out the root rotation at the crack front, Wang and
+    // Williams' correction adds it; the continuum lies between, near the corrected value.
+    enf.a0 = 40.0;
+    let c = initial_compliance(&enf.simulate(&law).unwrap());
+    let plain = enf_compliance(&m, b, h, l, 40.0);
+    let corrected = enf_compliance(&m, b, h, l, ww_crack(&m, h, 40.0));
+    eprintln!("ENF a0 = 40 mm: compliance {c:.6} mm/N; Timoshenko {plain:.6}, Wang–Williams {corrected:.6}");
+    assert!(c > plain && c < corrected, "{c} outside ({plain}, {corrected})");
+    assert!((c / corrected - 1.0).abs() < 0.02);
+}
+
+#[test]
+fn enf_with_a_long_crack_peaks_at_wang_williams_and_balances_energy() {
+    use czid_models::enf_2d::Enf2d;
+    let law = Bilinear::bk(1e6, 60.0, 150.0, 0.8, 2.0, 2.0).unwrap();
+    let mut enf = Enf2d::hartlen_enf03();
+    enf.a0 = 40.0;
+    let r = enf.simulate(&law).unwrap();
+    let (p, _) = peak(&r);
+    let a = ww_crack(&enf.material, enf.h, enf.a0);
+    let ww = 4.0 * enf.width / (3.0 * a) * (enf.material.e11 * enf.h.powi(3) * 2.0).sqrt();
+    eprintln!("ENF a0 = 40 mm: peak {p:.2} N vs Wang–Williams {ww:.2} N");
+    assert!((p / ww - 1.0).abs() < 0.03);
+    // The crack ran to the nose, and the energy balances all the way.
+    let tip = r.column(columns::CRACK_TIP).unwrap();
+    assert!(*tip.last().unwrap() > 48.0, "crack tip {}", tip.last().unwrap());
+    let w = r.column(columns::EXTERNAL_WORK).unwrap();
+    let u = r.column(columns::ELASTIC_ENERGY).unwrap();
+    let d = r.column(columns::DISSIPATED_ENERGY).unwrap();
+    for i in 1..w.len() {
+        assert!((w[i] - u[i] - d[i]).abs() <= 0.005 * w[i], "row {i}: W {} U {} D {}", w[i], u[i], d[i]);
+    }
+}
+
+#[test]
+fn enf_with_a_short_crack_snaps_back() {
+    use czid_models::enf_2d::Enf2d;
+    // a0 / L = 0.5: unstable under displacement control; the path follows the crack front, with
+    // the deflection at the nose falling while the crack runs.
+    let law = Bilinear::bk(1e6, 60.0, 150.0, 0.8, 2.0, 2.0).unwrap();
+    let mut enf = Enf2d::hartlen_enf03();
+    enf.a0 = 25.0;
+    let r = enf.simulate(&law).unwrap();
+    let d = r.column(columns::DISPLACEMENT).unwrap();
+    let back = d.windows(2).map(|w| (w[0] - w[1]).max(0.0)).fold(0.0, f64::max);
+    let tip = r.column(columns::CRACK_TIP).unwrap();
+    eprintln!(
+        "ENF a0 = 25 mm: largest fall of the deflection {back:.4} mm, crack tip at {:.2} mm",
+        tip.last().unwrap()
+    );
+    assert!(back > 0.01, "no snap-back recorded");
+    assert!(*tip.last().unwrap() > 45.0);
+}
+
+#[test]
+fn a_beam_dcb_maps_to_its_continuum_with_its_effects_as_material_changes() {
+    use czid_models::dcb::Dcb;
+    let mut beam = Dcb::hartlen_dcb01();
+    let plain = Dcb2d::from_beam(&beam).unwrap();
+    assert_eq!((plain.a0, plain.length, plain.width, plain.h), (beam.a0, beam.length, beam.width, beam.h));
+    assert_eq!(plain.material, beam.material);
+    beam.effects.root_compliance = 2e-4;
+    beam.effects.shear_compliance = 3e-4;
+    beam.effects.machine_compliance = 0.005;
+    beam.effects.crack_length_offset = 1.5;
+    let c = Dcb2d::from_beam(&beam).unwrap();
+    // Through-thickness compliance of an arm, h / (2 E22), grows by the root compliance.
+    let grown = beam.h / (2.0 * c.material.e22) - beam.h / (2.0 * beam.material.e22);
+    assert!((grown - 2e-4).abs() < 1e-15, "{grown}");
+    assert!((1.0 / c.material.g13 - 1.0 / beam.material.g13 - 3e-4).abs() < 1e-15);
+    assert_eq!((c.effects.machine_compliance, c.effects.crack_length_offset), (0.005, 1.5));
+    beam.symmetry = czid_models::dcb::Symmetry::Full;
+    beam.h_lower = Some(2.0);
+    assert!(Dcb2d::from_beam(&beam).unwrap_err().to_string().contains("equal arms"));
 }

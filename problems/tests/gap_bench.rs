@@ -11,7 +11,7 @@ fn scratch(name: &str) -> std::path::PathBuf {
 }
 
 fn one_null() -> BenchOptions {
-    BenchOptions { cases: 0, nulls: 1, seed: 3, effects: Vec::new(), family: Family::Dcb }
+    BenchOptions { cases: 0, nulls: 1, seed: 3, effects: Vec::new(), family: Family::Dcb, truth: Default::default() }
 }
 
 #[test]
@@ -51,4 +51,41 @@ fn families_are_named_and_plant_only_their_own_effects() {
     let opts = BenchOptions { effects: vec!["steel_hardening".into()], ..one_null() };
     let e = bench::run(&opts, None, None, &|_, _| {}).unwrap_err().to_string();
     assert!(e.contains("cannot be planted in the dcb benchmark"), "{e}");
+}
+
+#[test]
+fn continuum_truth_makes_the_tests_with_the_continuum_model_and_keeps_its_cases_apart() {
+    use bench::Truth;
+    use czid_core::ForwardModel;
+    let mut dcb = czid_models::dcb::Dcb::hartlen_dcb01();
+    dcb.effects.machine_compliance = 0.004;
+    let made = Truth::Continuum.model(&dcb).unwrap();
+    assert_eq!(made.name(), "dcb_2d");
+    assert_eq!(Truth::Beam.model(&dcb).unwrap().name(), "dcb");
+    // The planted effect travels with the specimen.
+    let json = serde_json::to_value(made.as_ref()).unwrap();
+    assert_eq!(json["effects"]["machine_compliance"], serde_json::json!(0.004));
+
+    let e = bench::run(
+        &BenchOptions { family: Family::Beam, truth: Truth::Continuum, ..one_null() },
+        None,
+        None,
+        &|_, _| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("no continuum model") && e.contains("--truth beam"), "{e}");
+    let e = "fem".parse::<Truth>().unwrap_err().to_string();
+    assert!(e.contains("beam, continuum"), "{e}");
+
+    // A continuum-made case runs, and is kept under its own name beside a beam-made one.
+    let dir = scratch("truth");
+    let store = CaseStore { dir: OutputDir::create(&dir, false, false).unwrap(), reuse: false };
+    let r =
+        bench::run(&BenchOptions { truth: Truth::Continuum, ..one_null() }, Some(&store), None, &|_, _| {}).unwrap();
+    assert!(r.cases[0].error.is_none(), "{:?}", r.cases[0].error);
+    let names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(names.iter().all(|n| n.contains("-continuum-")), "{names:?}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

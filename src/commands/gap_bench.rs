@@ -3,6 +3,7 @@
 //! ```text
 //! czid gap-bench --cases 20 --nulls 20 --seed 1 --out out/gap-bench
 //! czid gap-bench --family beam --cases 20 --out out/gap-bench-beam
+//! czid gap-bench --truth continuum --cases 20 --out out/gap-bench-continuum
 //! ```
 
 use crate::cluster::Cluster;
@@ -29,6 +30,10 @@ pub struct GapBenchArgs {
     /// Synthetic tests: `dcb` (Hartlen's specimens) or `beam` (the paper's FRP-strengthened beam).
     #[arg(long, default_value = "dcb")]
     pub family: String,
+    /// Model that makes the synthetic tests: `beam` (the diagnosed model itself) or `continuum`
+    /// (the continuum DCB: a different model of the same test; DCB family only).
+    #[arg(long, default_value = "beam")]
+    pub truth: String,
     /// Output folder (bench.json, bench.md, and each finished case in cases/).
     #[arg(long)]
     pub out: PathBuf,
@@ -49,6 +54,7 @@ pub fn run(args: &GapBenchArgs, cluster: &Cluster) -> Result<(), CzError> {
         seed: args.seed,
         effects: args.effects.clone(),
         family: args.family.parse::<Family>()?,
+        truth: args.truth.parse()?,
     };
     if cluster.is_worker() {
         let plan = bench::Plan::new(&opts)?;

@@ -122,6 +122,16 @@ pub fn graded_towards_end(x0: f64, x1: f64, fine: f64, coarse: f64, growth: f64)
     xs
 }
 
+/// Column positions over `[x0, x1]` growing geometrically from `fine` at `x0` towards `x1`, up
+/// to `coarse` (mm): the mirror image of [`graded_towards_end`].
+pub fn graded_from_start(x0: f64, x1: f64, fine: f64, coarse: f64, growth: f64) -> Vec<f64> {
+    let mirrored = graded_towards_end(0.0, x1 - x0, fine, coarse, growth);
+    let mut xs: Vec<f64> = mirrored.iter().rev().map(|&x| x0 + (x1 - x0) - x).collect();
+    xs[0] = x0;
+    *xs.last_mut().expect("at least two columns") = x1;
+    xs
+}
+
 /// Row heights from `y0` to `y1` in `n` equal elements.
 pub fn rows(y0: f64, y1: f64, n: usize) -> Vec<f64> {
     (0..=n).map(|i| if i == n { y1 } else { y0 + (y1 - y0) * i as f64 / n as f64 }).collect()

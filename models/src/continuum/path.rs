@@ -131,7 +131,7 @@ struct Solver<'a> {
 pub fn run(p: &ContinuumProblem, law: &dyn CohesiveLaw, settings: &PathSettings) -> Result<(Vec<Row>, Stats), Failure> {
     let n = p.unknowns();
     let mut held = vec![false; n];
-    for &d in p.fixed.iter().chain(&p.control) {
+    for &d in p.fixed.iter().chain(p.control.iter().map(|(d, _)| d)) {
         held[d] = true;
     }
     let system = p.system();
@@ -318,15 +318,15 @@ impl Solver<'_> {
 
     /// Residual (and tangent, when `tangent`) at `u` with the controlled unknowns at `delta`.
     fn evaluate(&mut self, u: &mut [f64], delta: f64, st: &State, control: &Control, tangent: bool) -> Evaluation {
-        for &c in &self.p.control {
-            u[c] = delta;
+        for &(c, w) in &self.p.control {
+            u[c] = w * delta;
         }
         let a = if tangent {
             self.p.assemble(&self.elements, self.law, u, &st.laws, &st.bubbles, Some(&mut self.system))
         } else {
             self.p.assemble(&self.elements, self.law, u, &st.laws, &st.bubbles, None)
         };
-        let reaction: f64 = self.p.control.iter().map(|&c| a.force[c]).sum();
+        let reaction: f64 = self.p.control.iter().map(|&(c, w)| w * a.force[c]).sum();
         let norm = (0..a.force.len()).filter(|&i| !self.held[i]).map(|i| a.force[i] * a.force[i]).sum::<f64>().sqrt();
         let constraint = match control {
             Control::Displacement(_) => 0.0,
@@ -338,12 +338,12 @@ impl Solver<'_> {
     /// The Newton update `(du, dδ)` from the assembled tangent.
     fn direction(&mut self, a: &Assembled, constraint: f64, control: &Control) -> Result<(Vec<f64>, f64), String> {
         let n = self.p.unknowns();
-        // Column and row of the control (summed over the controlled unknowns), before the held
+        // Column of the control (summed over the controlled unknowns with their factors), before the held
         // rows and columns are replaced by the identity.
         let mut col = vec![0.0; n];
-        for &c in &self.p.control {
+        for &(c, w) in &self.p.control {
             for i in self.system.neighbours(c) {
-                col[i] += self.system.get(i, c);
+                col[i] += w * self.system.get(i, c);
             }
         }
         for i in 0..n {

@@ -103,8 +103,9 @@ pub struct ContinuumProblem {
     pub contact_stiffness: f64,
     /// Unknowns held at zero.
     pub fixed: Vec<usize>,
-    /// Unknowns moved together by the applied displacement (the load is their summed reaction).
-    pub control: Vec<usize>,
+    /// Unknowns moved by the applied displacement `δ`, each with its factor (unknown = factor × δ);
+    /// the load is the reactions summed with the same factors.
+    pub control: Vec<(usize, f64)>,
     /// Which factorisation to use.
     pub solver: SolverKind,
 }

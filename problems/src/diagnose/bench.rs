@@ -7,8 +7,10 @@
 //! "none". Each finished case can be kept in a folder, so that an interrupted run resumes.
 
 mod family;
+mod truth;
 
 pub use family::{Family, TestDraw};
+pub use truth::Truth;
 
 use crate::data::Experiment;
 use crate::diagnose::candidate::{CandidateEffect, Library};
@@ -43,6 +45,8 @@ pub struct BenchOptions {
     pub effects: Vec<String>,
     /// The synthetic tests.
     pub family: Family,
+    /// The model that makes them.
+    pub truth: Truth,
 }
 
 /// One case's outcome.
@@ -125,6 +129,7 @@ fn case(
     effect: Option<&dyn CandidateEffect>,
     seed: u64,
     family: Family,
+    made_by: Truth,
     library: &Library,
 ) -> CaseResult {
     let clock = std::time::Instant::now();
@@ -156,7 +161,7 @@ fn case(
     };
     let mut run = || -> Result<()> {
         let base = family.base_setup(&truth, end)?;
-        let record = planted_record(&base, planted, effect, family, &mut size, &mut rng, &mut out)?;
+        let record = planted_record(&base, planted, effect, (family, made_by), &mut size, &mut rng, &mut out)?;
         // Without a set end the test is read up to a share of the deflection at its peak load.
         let end = match end {
             Some(e) => e,
@@ -202,7 +207,7 @@ fn planted_record(
     base: &Setup,
     planted: &str,
     effect: Option<&dyn CandidateEffect>,
-    family: Family,
+    (family, made_by): (Family, Truth),
     size: &mut Vec<f64>,
     rng: &mut ChaCha8Rng,
     out: &mut CaseResult,
@@ -213,7 +218,8 @@ fn planted_record(
             None => base.duplicate()?,
             Some(c) => c.apply(base, size)?,
         };
-        match true_setup.models[family.name()].simulate(true_setup.law.as_ref()) {
+        let model = made_by.model(true_setup.models[family.name()].as_ref())?;
+        match model.simulate(true_setup.law.as_ref()) {
             Ok(r) => return Ok(r),
             Err(_) if attempt < 5 && planted != NONE => {
                 attempt += 1;
@@ -272,7 +278,11 @@ fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
 /// Where a finished case is kept: its file name in the store (family, seed, index and planted
 /// effect say which case it is).
 fn case_file(opts: &BenchOptions, index: usize, planted: &str) -> String {
-    format!("case-{}-seed{}-{index:04}-{planted}.json", opts.family.name(), opts.seed)
+    let truth = match opts.truth {
+        Truth::Beam => String::new(),
+        t => format!("-{}", t.name()),
+    };
+    format!("case-{}{truth}-seed{}-{index:04}-{planted}.json", opts.family.name(), opts.seed)
 }
 
 /// A folder where each finished case is written at once (atomically).
@@ -305,6 +315,7 @@ impl Plan {
     pub fn new(opts: &BenchOptions) -> Result<Plan> {
         let library = Library::builtin();
         let family = opts.family;
+        opts.truth.check(family)?;
         // Every candidate that applies to the family's model and that it knows how to plant.
         let sample = family.base_setup(&family.draw(&mut ChaCha8Rng::seed_from_u64(0)).truth, None)?;
         let offered = library.names(&sample);
@@ -349,7 +360,7 @@ impl Plan {
     pub fn run_case(&self, i: usize) -> CaseResult {
         let p = &self.cases[i];
         let effect = self.candidates.iter().find(|c| c.name() == p).map(|c| c.as_ref());
-        case(i, p, effect, self.opts.seed, self.opts.family, &self.library)
+        case(i, p, effect, self.opts.seed, self.opts.family, self.opts.truth, &self.library)
     }
 
     /// Runs case `i` and gives its result as JSON (what a [`CaseFarm`] moves).
@@ -490,8 +501,9 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# gap-bench ({}): {} planted cases per effect, {} null cases, seed {}\n",
+        "# gap-bench ({}, tests made by the {} model): {} planted cases per effect, {} null cases, seed {}\n",
         opts.family.name(),
+        opts.truth.name(),
         opts.cases,
         opts.nulls,
         opts.seed
