@@ -37,6 +37,22 @@ fn row(name: &str, f: &Figures, reference: &Figures) {
     );
 }
 
+/// Root of an increasing `f` on `[lo, hi]` by bisection; `None` if it has none there or a run fails.
+fn bisect(f: impl Fn(f64) -> Option<f64>, mut lo: f64, mut hi: f64) -> Option<f64> {
+    if f(lo)? > 0.0 || f(hi)? < 0.0 {
+        return None;
+    }
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid)? < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
 fn compare(title: &str, beam: Dcb, continuum: Dcb2d, law: &dyn CohesiveLaw, at: f64) {
     println!("\n{title} (propagation load at {at} mm opening)\n");
     println!("| model | initial compliance (mm/N) | peak (N) | propagation load (N) |");
@@ -53,6 +69,30 @@ fn compare(title: &str, beam: Dcb, continuum: Dcb2d, law: &dyn CohesiveLaw, at: 
     match root.simulate(law) {
         Ok(r) => row("beam + root_compliance = h/(2 E22)", &figures(&r, at), &reference),
         Err(f) => println!("| beam + root_compliance = h/(2 E22) | failed: {} | | |", f.error),
+    }
+    // Each compliance effect sized so that the beam's initial compliance is the continuum's.
+    for effect in ["root_compliance", "shear_compliance"] {
+        let set = |b: &mut Dcb, v: f64| match effect {
+            "root_compliance" => b.effects.root_compliance = v,
+            _ => b.effects.shear_compliance = v,
+        };
+        let initial = |v: f64| {
+            let mut b = beam.clone();
+            set(&mut b, v);
+            b.control.max_displacement = Some(0.05 * beam.control.max_displacement.unwrap_or(1.0));
+            b.control.output_points = 2;
+            b.simulate(law).ok().map(|r| figures(&r, 0.0).compliance)
+        };
+        let Some(v) = bisect(|v| initial(v).map(|c| c - reference.compliance), 0.0, 2e-3) else {
+            println!("| beam + {effect} | no size matches the continuum's compliance | | |");
+            continue;
+        };
+        let mut b = beam.clone();
+        set(&mut b, v);
+        match b.simulate(law) {
+            Ok(r) => row(&format!("beam + {effect} = {v:.3e} (fitted)"), &figures(&r, at), &reference),
+            Err(f) => println!("| beam + {effect} = {v:.3e} (fitted) | failed: {} | | |", f.error),
+        }
     }
     println!(
         "\ncontinuum run: {seconds:.2} s, {} unknowns, {} steps, {} factorisations, solver {:.2} s",

@@ -25,7 +25,7 @@ use czid_core::{CohesiveLaw, CzError, ForwardModel, Record, Result, SimulationFa
 use serde::{Deserialize, Serialize};
 
 use crate::beamtest::{self, ControlSettings, Material, RowScale};
-use crate::continuum::grid::{graded_towards_end, rows, uniform, Grid};
+use crate::continuum::grid::{graded_rows, graded_towards_end, uniform, Grid};
 use crate::continuum::interface::{self, Pair};
 use crate::continuum::settings::record;
 use crate::continuum::{elasticity, path, ContinuumEffects, ContinuumMesh, ContinuumProblem, PathSettings, SolverKind};
@@ -196,7 +196,7 @@ impl Dcb2d {
         let mut xs = graded_towards_end(0.0, a, m.interface_element, m.arm_element.max(m.interface_element), 1.2);
         xs.extend_from_slice(&uniform(a, self.length, m.interface_element)[1..]);
         let ny = m.thickness_elements;
-        let grid = Grid::new(xs, vec![rows(0.0, self.h, ny)], self.width);
+        let grid = Grid::new(xs, vec![graded_rows(0.0, self.h, ny, m.thickness_grading)], self.width);
         let tip = grid.xs.iter().position(|&x| (x - a).abs() <= 1e-9 * self.length).unwrap_or(0);
         let nc = grid.xs.len();
         let pairs: Vec<Pair> =

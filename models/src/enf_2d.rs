@@ -27,7 +27,7 @@ use czid_core::{CohesiveLaw, CzError, ForwardModel, Record, Result, SimulationFa
 use serde::{Deserialize, Serialize};
 
 use crate::beamtest::{self, ControlSettings, Material, RowScale};
-use crate::continuum::grid::{graded_from_start, graded_towards_end, rows, uniform, Grid};
+use crate::continuum::grid::{graded_from_start, graded_rows, graded_towards_end, uniform, Grid};
 use crate::continuum::interface::{self, Pair};
 use crate::continuum::settings::record;
 use crate::continuum::{elasticity, path, ContinuumEffects, ContinuumMesh, ContinuumProblem, PathSettings, SolverKind};
@@ -148,7 +148,9 @@ impl Enf2d {
         xs.extend_from_slice(&uniform(a, l, fine)[1..]);
         xs.extend_from_slice(&graded_from_start(l, 2.0 * l, fine, coarse, 1.2)[1..]);
         let ny = m.thickness_elements;
-        let grid = Grid::new(xs, vec![rows(0.0, self.h, ny), rows(self.h, 2.0 * self.h, ny)], self.width);
+        let g = m.thickness_grading;
+        let arms = vec![graded_rows(0.0, self.h, ny, 1.0 / g), graded_rows(self.h, 2.0 * self.h, ny, g)];
+        let grid = Grid::new(xs, arms, self.width);
         let nc = grid.xs.len();
         let at = |x: f64| grid.xs.iter().position(|&v| (v - x).abs() <= 1e-9 * l).unwrap_or(0);
         let (tip, mid) = (at(a), at(l));

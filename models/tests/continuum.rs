@@ -288,3 +288,86 @@ fn a_beam_dcb_maps_to_its_continuum_with_its_effects_as_material_changes() {
     beam.h_lower = Some(2.0);
     assert!(Dcb2d::from_beam(&beam).unwrap_err().to_string().contains("equal arms"));
 }
+
+/// A short, coarse run of Hartlen's DCB (quick; for the effects' checks).
+fn quick_hartlen() -> Dcb2d {
+    let mut dcb = Dcb2d::hartlen_dcb01();
+    dcb.mesh.interface_element = 0.5;
+    dcb.mesh.thickness_elements = 2;
+    dcb.control.max_displacement = Some(6.0);
+    dcb.control.output_points = 30;
+    dcb
+}
+
+#[test]
+fn effects_switched_off_are_the_base_model_and_switched_on_act_as_declared() {
+    let law = Bilinear::bk(1e5, 30.0, 30.0, 0.8, 2.0, 2.0).unwrap();
+    let base = quick_hartlen();
+    let r0 = base.simulate(&law).unwrap();
+    // Null values: bit for bit the base model.
+    let mut nulls = base.clone();
+    nulls.effects = czid_models::continuum::ContinuumEffects {
+        machine_compliance: 0.0,
+        crack_length_offset: 0.0,
+        displacement_offset: 0.0,
+        large_rotation: false,
+    };
+    assert_eq!(nulls.simulate(&law).unwrap(), r0);
+    let d0 = r0.column(columns::DISPLACEMENT).unwrap();
+    let p0 = r0.column(columns::LOAD).unwrap();
+
+    // Machine compliance: the same states, each recorded C_m P further.
+    let mut m = base.clone();
+    m.effects.machine_compliance = 0.004;
+    let r = m.simulate(&law).unwrap();
+    let (d, p) = (r.column(columns::DISPLACEMENT).unwrap(), r.column(columns::LOAD).unwrap());
+    for i in 0..d.len().min(d0.len()) {
+        assert!((p[i] - p0[i]).abs() < 1e-9 * p0[i].abs().max(1.0));
+        assert!((d[i] - d0[i] - 0.004 * p0[i]).abs() < 1e-9, "row {i}");
+    }
+
+    // Displacement offset: an unloaded toe, then every state shifted.
+    let mut o = base.clone();
+    o.effects.displacement_offset = 0.3;
+    let r = o.simulate(&law).unwrap();
+    let d = r.column(columns::DISPLACEMENT).unwrap();
+    assert_eq!((d[0], r.column(columns::LOAD).unwrap()[0]), (0.0, 0.0));
+    assert!((d[2] - d0[1] - 0.3).abs() < 1e-12);
+
+    // A longer crack: more compliant (beam theory's a³ for the leading term), and the crack
+    // front where the offset puts it.
+    let mut c = base.clone();
+    c.effects.crack_length_offset = 3.0;
+    let r = c.simulate(&law).unwrap();
+    let compliance = |r: &Record| r.column(columns::DISPLACEMENT).unwrap()[1] / r.column(columns::LOAD).unwrap()[1];
+    let ratio = compliance(&r) / compliance(&r0);
+    let a = base.a0;
+    let cube = ((a + 3.0) / a).powi(3);
+    assert!(ratio > 1.0 && ratio < cube, "compliance ratio {ratio} (a³ ratio {cube})");
+    assert_eq!(r.column(columns::CRACK_TIP).unwrap()[0], a + 3.0);
+}
+
+#[test]
+fn large_displacements_agree_with_small_strain_at_small_openings_and_follow_the_astm_correction_at_large_ones() {
+    let law = Bilinear::bk(1e5, 30.0, 30.0, 0.8, 2.0, 2.0).unwrap();
+    let mut small = quick_hartlen();
+    small.control.max_displacement = Some(30.0);
+    let mut large = small.clone();
+    large.effects.large_rotation = true;
+    let (rs, rl) = (small.simulate(&law).unwrap(), large.simulate(&law).unwrap());
+    let c = |r: &Record| r.column(columns::DISPLACEMENT).unwrap()[1] / r.column(columns::LOAD).unwrap()[1];
+    assert!((c(&rl) / c(&rs) - 1.0).abs() < 1e-3, "initial compliance {} vs {}", c(&rl), c(&rs));
+    // At 25 mm (δ/a about 0.3) the loads differ by the geometric non-linearity, which ASTM D5528
+    // corrects G for with F = 1 − 0.3 (δ/a)² − 1.5 δt/a².
+    let at = |r: &Record| load_at(r.column(columns::DISPLACEMENT).unwrap(), r.column(columns::LOAD).unwrap(), 25.0);
+    let (ps, pl) = (at(&rs), at(&rl));
+    // At the same G_c the load scales as 1/√F (the hinges' offset t = 0 here).
+    let a = load_at(rs.column(columns::DISPLACEMENT).unwrap(), rs.column(columns::CRACK_TIP).unwrap(), 25.0);
+    let f = 1.0 - 0.3 * (25.0 / a).powi(2);
+    eprintln!(
+        "Hartlen DCB at 25 mm (a = {a:.1} mm): small strain {ps:.3} N, large {pl:.3} N, ratio {:.4} vs 1/√F = {:.4}",
+        pl / ps,
+        1.0 / f.sqrt()
+    );
+    assert!(pl > ps && (pl / ps * f.sqrt() - 1.0).abs() < 0.01, "{pl} vs {ps}");
+}

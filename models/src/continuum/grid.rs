@@ -134,7 +134,21 @@ pub fn graded_from_start(x0: f64, x1: f64, fine: f64, coarse: f64, growth: f64) 
 
 /// Row heights from `y0` to `y1` in `n` equal elements.
 pub fn rows(y0: f64, y1: f64, n: usize) -> Vec<f64> {
-    (0..=n).map(|i| if i == n { y1 } else { y0 + (y1 - y0) * i as f64 / n as f64 }).collect()
+    graded_rows(y0, y1, n, 1.0)
+}
+
+/// Row heights from `y0` to `y1` in `n` elements, each `growth` times as thick as the one before
+/// (`growth < 1`: thinning towards `y1`).
+pub fn graded_rows(y0: f64, y1: f64, n: usize, growth: f64) -> Vec<f64> {
+    let weights: Vec<f64> = (0..n).map(|i| growth.powi(i as i32)).collect();
+    let total: f64 = weights.iter().sum();
+    let mut ys = vec![y0];
+    let mut acc = 0.0;
+    for (i, w) in weights.iter().enumerate() {
+        acc += w;
+        ys.push(if i + 1 == n { y1 } else { y0 + (y1 - y0) * acc / total });
+    }
+    ys
 }
 
 #[cfg(test)]
@@ -148,6 +162,14 @@ mod tests {
         assert_eq!(*xs.last().unwrap(), 50.0);
         assert!((xs[xs.len() - 1] - xs[xs.len() - 2] - 0.1).abs() < 1e-9);
         assert!(xs.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] <= 1.0 + 0.1));
+    }
+
+    #[test]
+    fn graded_rows_grow_by_the_ratio() {
+        let ys = graded_rows(0.0, 15.0, 4, 2.0);
+        assert_eq!(ys, vec![0.0, 1.0, 3.0, 7.0, 15.0]);
+        let down = graded_rows(0.0, 15.0, 4, 0.5);
+        assert!((down[4] - down[3] - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -193,7 +193,7 @@ pub fn run(p: &ContinuumProblem, law: &dyn CohesiveLaw, settings: &PathSettings)
             let control = Control::Opening { point, target: now + opening_step };
             let result = s.step(&state, control).and_then(|next| {
                 // A converged state far from the last one (another branch) is not the path.
-                if (next.delta - state.delta).abs() > grid || next.reaction * state.reaction < 0.0 {
+                if (next.delta - state.delta).abs() > 10.0 * grid || next.reaction * state.reaction < 0.0 {
                     Err(format!("the step jumped from {} to {} mm", state.delta, next.delta))
                 } else {
                     Ok(next)

@@ -20,6 +20,9 @@ pub struct ContinuumMesh {
     pub arm_element: f64,
     /// Elements through the thickness of each arm.
     pub thickness_elements: usize,
+    /// Ratio of each element's thickness to the next one's towards the interface (≥ 1; 1:
+    /// uniform): fine where the crack runs, coarse at the arms' outer faces.
+    pub thickness_grading: f64,
     /// Gauss points per interface element (1–4), or 0 for nodal (Newton–Cotes) integration; see
     /// [`crate::continuum::interface`].
     pub interface_points: usize,
@@ -27,7 +30,13 @@ pub struct ContinuumMesh {
 
 impl Default for ContinuumMesh {
     fn default() -> Self {
-        ContinuumMesh { interface_element: 0.1, arm_element: 1.0, thickness_elements: 4, interface_points: 4 }
+        ContinuumMesh {
+            interface_element: 0.1,
+            arm_element: 1.0,
+            thickness_elements: 4,
+            thickness_grading: 1.0,
+            interface_points: 4,
+        }
     }
 }
 
@@ -53,6 +62,14 @@ impl ContinuumMesh {
                 "mesh.thickness_elements",
                 self.thickness_elements as f64,
                 "must be between 1 and 64",
+            ));
+        }
+        if !(self.thickness_grading.is_finite() && (1.0..=10.0).contains(&self.thickness_grading)) {
+            return Err(CzError::invalid(
+                owner,
+                "mesh.thickness_grading",
+                self.thickness_grading,
+                "must lie in [1, 10] (1: uniform)",
             ));
         }
         if self.interface_points > 4 {
