@@ -297,21 +297,22 @@ impl Solver<'_> {
             let merit = |e: &Evaluation| e.norm + e.constraint.abs() * weight;
             let start = norm + constraint.abs() * weight;
             let mut alpha = 1.0;
-            loop {
+            current = loop {
                 let mut trial = u.clone();
                 for i in 0..n {
                     trial[i] += alpha * du[i];
                 }
                 let td = delta + alpha * dd;
-                let e = self.evaluate(&mut trial, td, st, &control, false);
+                // The full update usually stands: assemble its tangent with its residual.
+                let full = alpha == 1.0;
+                let e = self.evaluate(&mut trial, td, st, &control, full);
                 if merit(&e) < start || alpha < 0.1 || iteration == 0 {
                     u = trial;
                     delta = td;
-                    break;
+                    break if full { e } else { self.evaluate(&mut u, delta, st, &control, true) };
                 }
                 alpha *= 0.5;
-            }
-            current = self.evaluate(&mut u, delta, st, &control, true);
+            };
         }
         Err(format!("Newton did not converge in {} iterations", self.settings.max_iterations))
     }

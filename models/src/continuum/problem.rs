@@ -133,10 +133,10 @@ pub struct Assembled {
     pub bubbles: Vec<Vector4<f64>>,
 }
 
-/// The elements and, in small strain, their constant tangents.
+/// The elements and, in small strain, the arms' constant stiffness matrix, assembled once.
 pub struct Elements {
     list: Vec<([usize; 4], Quad)>,
-    linear: Option<Vec<ElementTangent>>,
+    linear: Option<System>,
 }
 
 impl ContinuumProblem {
@@ -145,13 +145,25 @@ impl ContinuumProblem {
         2 * self.grid.nodes()
     }
 
-    /// The elements (their small-strain tangents computed once).
+    /// The elements (in small strain, the arms' stiffness matrix assembled once: each Newton
+    /// iteration copies it and multiplies by it instead of visiting every element).
     pub fn elements(&self) -> Elements {
         let list = self.grid.elements();
         let linear = (!self.large).then(|| {
-            list.par_iter()
+            let tangents: Vec<ElementTangent> = list
+                .par_iter()
                 .map(|(_, q)| q.respond(&ElementForce::zeros(), &self.stiffness, false, &Vector4::zeros()).tangent)
-                .collect()
+                .collect();
+            let mut bulk = self.system();
+            for ((nodes, _), k) in list.iter().zip(&tangents) {
+                let dofs: [usize; 8] = std::array::from_fn(|i| 2 * nodes[i / 2] + i % 2);
+                for a in 0..8 {
+                    for b in 0..8 {
+                        bulk.add(dofs[a], dofs[b], k[(a, b)]);
+                    }
+                }
+            }
+            bulk
         });
         Elements { list, linear }
     }
@@ -193,46 +205,41 @@ impl ContinuumProblem {
         let n = self.unknowns();
         let mut force = vec![0.0; n];
         let mut bulk_energy = 0.0;
-        if let Some(s) = system.as_deref_mut() {
-            s.clear();
-        }
-        let gather = |nodes: &[usize; 4]| ElementForce::from_fn(|i, _| u[2 * nodes[i / 2] + i % 2]);
         let mut new_bubbles = Vec::new();
-        let responses: Vec<(ElementForce, ElementTangent, f64)> = match &elements.linear {
-            Some(ks) => elements
-                .list
-                .iter()
-                .zip(ks)
-                .map(|((nodes, _), k)| {
-                    let ue = gather(nodes);
-                    let f = k * ue;
-                    let e = 0.5 * ue.dot(&f);
-                    (f, *k, e)
-                })
-                .collect(),
+        match &elements.linear {
+            Some(bulk) => {
+                bulk.mul_vec(u, &mut force);
+                bulk_energy = 0.5 * u.iter().zip(&force).map(|(a, b)| a * b).sum::<f64>();
+                if let Some(s) = system.as_deref_mut() {
+                    s.copy_from(bulk);
+                }
+            }
             None => {
-                let r: Vec<_> = elements
+                if let Some(s) = system.as_deref_mut() {
+                    s.clear();
+                }
+                let gather = |nodes: &[usize; 4]| ElementForce::from_fn(|i, _| u[2 * nodes[i / 2] + i % 2]);
+                let responses: Vec<_> = elements
                     .list
                     .par_iter()
                     .enumerate()
                     .map(|(i, (nodes, q))| q.respond(&gather(nodes), &self.stiffness, true, &bubbles[i]))
                     .collect();
-                new_bubbles = r.iter().map(|r| r.bubbles).collect();
-                r.into_iter().map(|r| (r.force, r.tangent, r.energy)).collect()
-            }
-        };
-        for ((nodes, _), (f, k, e)) in elements.list.iter().zip(&responses) {
-            bulk_energy += e;
-            let dofs: [usize; 8] = std::array::from_fn(|i| 2 * nodes[i / 2] + i % 2);
-            for a in 0..8 {
-                force[dofs[a]] += f[a];
-            }
-            if let Some(s) = system.as_deref_mut() {
-                for a in 0..8 {
-                    for b in 0..8 {
-                        s.add(dofs[a], dofs[b], k[(a, b)]);
+                for ((nodes, _), r) in elements.list.iter().zip(&responses) {
+                    bulk_energy += r.energy;
+                    let dofs: [usize; 8] = std::array::from_fn(|i| 2 * nodes[i / 2] + i % 2);
+                    for a in 0..8 {
+                        force[dofs[a]] += r.force[a];
+                    }
+                    if let Some(s) = system.as_deref_mut() {
+                        for a in 0..8 {
+                            for b in 0..8 {
+                                s.add(dofs[a], dofs[b], r.tangent[(a, b)]);
+                            }
+                        }
                     }
                 }
+                new_bubbles = responses.iter().map(|r| r.bubbles).collect();
             }
         }
         let mut trial = InterfaceTrial::default();

@@ -87,6 +87,30 @@ impl System {
         }
     }
 
+    /// Takes the entries of `other` (a system of the same pattern).
+    pub fn copy_from(&mut self, other: &System) {
+        match (&mut self.store, &other.store) {
+            (Store::Band(a), Store::Band(b)) => a.copy_from(b),
+            (Store::Sparse(a), Store::Sparse(b)) => a.values.copy_from_slice(&b.values),
+            _ => unreachable!("systems of one problem share their storage"),
+        }
+    }
+
+    /// `y = A x` (before factorisation).
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        match &self.store {
+            Store::Band(b) => b.mul_vec(x, y),
+            Store::Sparse(s) => {
+                y.fill(0.0);
+                for j in 0..s.n {
+                    for p in s.col_ptr[j]..s.col_ptr[j + 1] {
+                        y[s.row_idx[p]] += s.values[p] * x[j];
+                    }
+                }
+            }
+        }
+    }
+
     /// Adds `v` to entry `(i, j)` (which must be in the pattern).
     pub fn add(&mut self, i: usize, j: usize, v: f64) {
         match &mut self.store {
