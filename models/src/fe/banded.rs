@@ -7,7 +7,7 @@
 //! `n · bw²` operations with unit-stride inner loops and no index indirection, and its "symbolic
 //! analysis" (the band) is fixed by the mesh and reused for every factorisation. (A general sparse
 //! LU such as faer's has to do at least the same arithmetic plus index indirection: on the
-//! continuum DCB it measured 7.8 times slower, see the book's "Beam or continuum?" chapter.)
+//! continuum DCB it measured 9 times slower, see the book's "Beam or continuum?" chapter.)
 //!
 //! No pivoting: the stiffness matrices of this engine are symmetric positive definite except
 //! where cohesive softening enters, which only adds small (possibly negative) contributions to a
