@@ -56,7 +56,6 @@ fn families_are_named_and_plant_only_their_own_effects() {
 #[test]
 fn continuum_truth_makes_the_tests_with_the_continuum_model_and_keeps_its_cases_apart() {
     use bench::Truth;
-    use czid_core::ForwardModel;
     let mut dcb = czid_models::dcb::Dcb::hartlen_dcb01();
     dcb.effects.machine_compliance = 0.004;
     let made = Truth::Continuum.model(&dcb).unwrap();
