@@ -68,4 +68,12 @@ pub trait ForwardModel: Send + Sync + std::fmt::Debug {
     fn regimes(&self) -> &'static dyn RegimeRule {
         &GenericRegimes
     }
+
+    /// An independent model of the same test and specimen, of higher fidelity and built on other
+    /// assumptions (e.g. a continuum model of a beam model), effects carried over (default:
+    /// none). The diagnosis runs it at the fitted law to tell the misfit that this model's own
+    /// form leaves on any test from the misfit an unmodelled effect makes.
+    fn reference(&self) -> Option<Box<dyn ForwardModel>> {
+        None
+    }
 }

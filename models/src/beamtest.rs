@@ -224,8 +224,6 @@ pub fn new_record() -> Record {
 pub struct RowScale {
     /// Recorded displacement per unit of the control unknown.
     pub displacement: f64,
-    /// Added to the recorded displacement (seating offset).
-    pub offset: f64,
     /// Added to the recorded displacement per unit recorded load (mm/N): a compliant machine
     /// whose load train is not part of the mesh (see [`crate::measurement::recorded_control`]).
     pub compliance: f64,
@@ -233,27 +231,55 @@ pub struct RowScale {
     pub load: f64,
     /// Whole-specimen energy per unit energy of the simulated part (2 for a half model).
     pub energy: f64,
+    /// How the instruments read the specimen's displacement and load (offsets, a seating toe).
+    pub readout: crate::measurement::Readout,
+}
+
+impl RowScale {
+    /// The specimen's displacement and load in a state of control value `control` and reaction
+    /// `reaction`, a compliant machine's share included, before the instruments read them.
+    pub fn specimen(&self, control: f64, reaction: f64) -> (f64, f64) {
+        let p = self.load * reaction;
+        // Without a compliance the sum is the one the base model always recorded, bit for bit.
+        let delta = if self.compliance == 0.0 {
+            self.displacement * control
+        } else {
+            self.displacement * control + self.compliance * p
+        };
+        (delta, p)
+    }
+
+    /// The recorded displacement and load of every state `(control, reaction)`, an unloaded first
+    /// reading first when the readout has a displacement offset (the sharp toe).
+    pub fn readings(&self, states: impl Iterator<Item = (f64, f64)> + Clone) -> Vec<[f64; 2]> {
+        let specimen = states.map(|(c, r)| self.specimen(c, r));
+        let c0 = crate::measurement::initial_compliance(specimen.clone());
+        let mut out = Vec::new();
+        if let Some(first) = self.readout.unloaded() {
+            out.push(first);
+        }
+        out.extend(specimen.map(|(d, p)| {
+            let (d, p) = self.readout.read(d, p, c0);
+            [d, p]
+        }));
+        out
+    }
 }
 
 /// Converts engine rows to a record.
 pub fn to_record(rows: &[StepRow], s: &RowScale) -> Record {
     let mut rec = new_record();
-    if s.offset > 0.0 {
-        // The seating toe: the load stays at zero until the offset is taken up.
+    let readings = s.readings(rows.iter().map(|r| (r.control, r.reaction)));
+    let unloaded = readings.len() > rows.len();
+    if unloaded {
+        // The seating toe: the load stays at its zero until the offset is taken up.
         let tip = rows.first().map_or(0.0, |r| r.crack.tip);
-        rec.push(&[0.0, 0.0, 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
+        rec.push(&[readings[0][0], readings[0][1], 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
     }
-    for r in rows {
-        let p = s.load * r.reaction;
-        // Without a compliance the sum is the one the base model always recorded, bit for bit.
-        let delta = if s.compliance == 0.0 {
-            s.displacement * r.control
-        } else {
-            s.displacement * r.control + s.compliance * p
-        };
+    for (r, [delta, p]) in rows.iter().zip(&readings[usize::from(unloaded)..]) {
         rec.push(&[
-            delta + s.offset,
-            p,
+            *delta,
+            *p,
             r.crack.debonded,
             r.crack.process_zone,
             r.crack.tip,

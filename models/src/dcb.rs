@@ -268,8 +268,7 @@ impl Dcb {
         // Opening per unit of the loaded arm's deflection.
         let arm_to_opening = if half { 2.0 } else { 1.0 };
         let load_point = LoadPoint { dof: w_up, per_unit: arm_to_opening, share: factor, at_first_node: true };
-        let (control, scale) =
-            recorded_control(fx.machine_compliance, fx.displacement_offset, load_point, &mut springs);
+        let (control, scale) = recorded_control(fx.machine_compliance, fx.readout(), load_point, &mut springs);
         let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: large, contact_stiffness: 0.0 };
         Ok((p, scale))
     }
@@ -300,6 +299,12 @@ impl ForwardModel for Dcb {
 
     fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
         Effects::declarations(true)
+    }
+
+    /// The continuum DCB of the same specimen ([`crate::dcb_2d::Dcb2d::from_beam`]); none for
+    /// unequal arms or a whole-specimen mesh.
+    fn reference(&self) -> Option<Box<dyn ForwardModel>> {
+        crate::dcb_2d::Dcb2d::from_beam(self).ok().map(|m| Box::new(m) as Box<dyn ForwardModel>)
     }
 
     /// The interface elements must be shorter than the cohesive zone (refused otherwise: the

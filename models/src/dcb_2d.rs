@@ -135,6 +135,8 @@ impl Dcb2d {
                 crack_length_offset: fx.crack_length_offset,
                 displacement_offset: fx.displacement_offset,
                 large_rotation: fx.large_rotation,
+                load_offset: fx.load_offset,
+                seating_toe: fx.seating_toe,
             },
             solver: SolverKind::default(),
         })
@@ -204,12 +206,8 @@ impl Dcb2d {
         let cohesive = interface::line(&pairs, self.width, m.interface_points);
         let hinge = grid.node(0, 0, ny / 2);
         let load_point = LoadPoint { dof: 2 * hinge + 1, per_unit: 2.0, share: 0.5, at_first_node: false };
-        let (control, scale) = recorded_control(
-            self.effects.machine_compliance,
-            self.effects.displacement_offset,
-            load_point,
-            &mut Vec::new(),
-        );
+        let (control, scale) =
+            recorded_control(self.effects.machine_compliance, self.effects.readout(), load_point, &mut Vec::new());
         let p = ContinuumProblem {
             grid,
             stiffness: elasticity::plane_stress(&self.material, OWNER)?,

@@ -34,6 +34,10 @@ pub struct Effects {
     pub shear_compliance: f64,
     /// Large rotations (co-rotational beams and interface frames) instead of small rotations.
     pub large_rotation: bool,
+    /// Load-cell zero offset (N): every recorded load is `P + offset`. 0: none.
+    pub load_offset: f64,
+    /// Depth of a smooth seating toe (mm), see [`crate::measurement::Readout`]. 0: none.
+    pub seating_toe: f64,
 }
 
 /// Large rotations of the arms (a switch).
@@ -87,14 +91,23 @@ impl Effects {
     /// The switchable effects of a beam test, in the order the diagnosis lists them: large
     /// rotations when the model supports them, the specimen's effects and the measurement's.
     pub fn declarations(large_rotation: bool) -> Vec<EffectDeclaration> {
-        use crate::measurement::{DISPLACEMENT_OFFSET, MACHINE_COMPLIANCE};
+        use crate::measurement::{DISPLACEMENT_OFFSET, LOAD_OFFSET, MACHINE_COMPLIANCE, SEATING_TOE};
         let [root, crack, shear] = SPECIMEN;
         let mut out = Vec::new();
         if large_rotation {
             out.push(LARGE_ROTATION);
         }
-        out.extend([root, MACHINE_COMPLIANCE, crack, DISPLACEMENT_OFFSET, shear]);
+        out.extend([root, MACHINE_COMPLIANCE, crack, DISPLACEMENT_OFFSET, shear, LOAD_OFFSET, SEATING_TOE]);
         out
+    }
+
+    /// How the instruments read the specimen (the measurement effects but the machine's).
+    pub fn readout(&self) -> crate::measurement::Readout {
+        crate::measurement::Readout {
+            displacement_offset: self.displacement_offset,
+            load_offset: self.load_offset,
+            seating_toe: self.seating_toe,
+        }
     }
 
     /// Checks every value, naming the field of `owner` that is invalid.
@@ -102,6 +115,10 @@ impl Effects {
         require_non_negative(owner, "effects.machine_compliance", self.machine_compliance)?;
         require_non_negative(owner, "effects.root_compliance", self.root_compliance)?;
         require_non_negative(owner, "effects.shear_compliance", self.shear_compliance)?;
+        require_non_negative(owner, "effects.seating_toe", self.seating_toe)?;
+        if !self.load_offset.is_finite() {
+            return Err(CzError::invalid(owner, "effects.load_offset", self.load_offset, "must be finite"));
+        }
         if !self.crack_length_offset.is_finite() {
             return Err(CzError::invalid(
                 owner,

@@ -179,12 +179,8 @@ impl Enf {
         // The load nose pushes the upper arm down: recorded deflection and load are positive.
         let load_point =
             crate::measurement::LoadPoint { dof: w_load, per_unit: -1.0, share: 1.0, at_first_node: false };
-        let (control, scale) = crate::measurement::recorded_control(
-            fx.machine_compliance,
-            fx.displacement_offset,
-            load_point,
-            &mut springs,
-        );
+        let (control, scale) =
+            crate::measurement::recorded_control(fx.machine_compliance, fx.readout(), load_point, &mut springs);
         let contact_stiffness = self.contact_stiffness.unwrap_or(law.initial_stiffness()[0]);
         let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: false, contact_stiffness };
         Ok((p, scale))
@@ -208,6 +204,11 @@ impl ForwardModel for Enf {
     fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
         // The ENF model has no large-rotation option (it refuses `effects.large_rotation`).
         crate::effects::Effects::declarations(false)
+    }
+
+    /// The continuum ENF of the same specimen ([`crate::enf_2d::Enf2d::from_beam`]).
+    fn reference(&self) -> Option<Box<dyn ForwardModel>> {
+        crate::enf_2d::Enf2d::from_beam(self).ok().map(|m| Box::new(m) as Box<dyn ForwardModel>)
     }
 
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {

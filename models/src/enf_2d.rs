@@ -88,6 +88,43 @@ impl Enf2d {
         }
     }
 
+    /// The continuum ENF of the specimen a beam ENF describes, with the beam's effects carried
+    /// over as [`crate::dcb_2d::Dcb2d::from_beam`] does (the extra compliances as the material
+    /// change they stand for). The mesh keeps the beam's interface element.
+    pub fn from_beam(beam: &crate::enf::Enf) -> Result<Enf2d> {
+        let fx = &beam.effects;
+        let mut material = beam.material.clone();
+        if fx.root_compliance > 0.0 {
+            material.e22 = 1.0 / (1.0 / material.e22 + 2.0 * fx.root_compliance / beam.h);
+        }
+        material.g13 = fx.shear_modulus(material.g13);
+        let m = Enf2d {
+            a0: beam.a0,
+            half_span: beam.half_span,
+            width: beam.width,
+            h: beam.h,
+            material,
+            contact_stiffness: beam.contact_stiffness,
+            mesh: ContinuumMesh {
+                interface_element: beam.mesh.interface_element,
+                arm_element: beam.mesh.arm_element.max(beam.mesh.interface_element),
+                ..Default::default()
+            },
+            control: beam.control.clone(),
+            effects: ContinuumEffects {
+                machine_compliance: fx.machine_compliance,
+                crack_length_offset: fx.crack_length_offset,
+                displacement_offset: fx.displacement_offset,
+                large_rotation: false,
+                load_offset: fx.load_offset,
+                seating_toe: fx.seating_toe,
+            },
+            solver: SolverKind::default(),
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
     /// Checks the configuration, naming the first invalid field.
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [("a0", self.a0), ("half_span", self.half_span), ("width", self.width), ("h", self.h)] {
@@ -165,12 +202,8 @@ impl Enf2d {
         // The nose pushes both arms' sections down: the control is positive downwards.
         let nose: Vec<usize> = (0..=ny).flat_map(|r| [grid.node(0, mid, r), grid.node(1, mid, r)]).collect();
         let load_point = LoadPoint { dof: 2 * nose[0] + 1, per_unit: 1.0, share: 1.0, at_first_node: false };
-        let (_, scale) = recorded_control(
-            self.effects.machine_compliance,
-            self.effects.displacement_offset,
-            load_point,
-            &mut Vec::new(),
-        );
+        let (_, scale) =
+            recorded_control(self.effects.machine_compliance, self.effects.readout(), load_point, &mut Vec::new());
         let p = ContinuumProblem {
             stiffness: elasticity::plane_stress(&self.material, OWNER)?,
             large: false,

@@ -311,6 +311,8 @@ fn effects_switched_off_are_the_base_model_and_switched_on_act_as_declared() {
         crack_length_offset: 0.0,
         displacement_offset: 0.0,
         large_rotation: false,
+        load_offset: 0.0,
+        seating_toe: 0.0,
     };
     assert_eq!(nulls.simulate(&law).unwrap(), r0);
     let d0 = r0.column(columns::DISPLACEMENT).unwrap();
@@ -370,4 +372,17 @@ fn large_displacements_agree_with_small_strain_at_small_openings_and_follow_the_
         1.0 / f.sqrt()
     );
     assert!(pl > ps && (pl / ps * f.sqrt() - 1.0).abs() < 0.01, "{pl} vs {ps}");
+}
+
+#[test]
+fn the_beam_models_name_their_continuum_counterpart_as_reference() {
+    use czid_core::ForwardModel;
+    let mut dcb = czid_models::dcb::Dcb::hartlen_dcb01();
+    dcb.effects.load_offset = 1.5;
+    let reference = dcb.reference().expect("a DCB of equal arms has a continuum counterpart");
+    assert_eq!(reference.name(), "dcb_2d");
+    assert_eq!(serde_json::to_value(&reference).unwrap()["effects"]["load_offset"], serde_json::json!(1.5));
+    let enf = czid_models::enf::Enf::hartlen_enf03();
+    assert_eq!(enf.reference().unwrap().name(), "enf_2d");
+    assert!(czid_models::frp::beam::FrpBeam::paper().unwrap().reference().is_none());
 }

@@ -32,7 +32,8 @@ fn null_effects_written_out_reproduce_the_base_model_bitwise() {
     let mut v = serde_json::to_value(&d).unwrap();
     v["effects"] = serde_json::json!({
         "machine_compliance": 0.0, "crack_length_offset": 0.0, "displacement_offset": 0.0,
-        "root_compliance": 0.0, "shear_compliance": 0.0, "large_rotation": false
+        "root_compliance": 0.0, "shear_compliance": 0.0, "large_rotation": false,
+        "load_offset": 0.0, "seating_toe": 0.0
     });
     let explicit: Dcb = serde_json::from_value(v).unwrap();
     assert_eq!(run(&d, &law()), run(&explicit, &law()));
@@ -57,6 +58,37 @@ fn displacement_offset_shifts_the_curve_and_adds_a_toe() {
     assert_eq!((x1[0], col(&r1, columns::LOAD)[0]), (0.0, 0.0));
     for (a, b) in x0.iter().zip(&x1[1..]) {
         assert!((b - a - 0.3).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn load_offset_shifts_every_load_and_nothing_else() {
+    let mut d = base();
+    d.effects.load_offset = -2.5;
+    let (r0, r1) = (run(&base(), &law()), run(&d, &law()));
+    assert_eq!(r1.rows(), r0.rows());
+    assert_eq!(col(&r1, columns::DISPLACEMENT), col(&r0, columns::DISPLACEMENT));
+    assert_eq!(col(&r1, columns::DEBONDED_LENGTH), col(&r0, columns::DEBONDED_LENGTH));
+    for (a, b) in col(&r0, columns::LOAD).iter().zip(col(&r1, columns::LOAD)) {
+        assert!((b - a + 2.5).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn seating_toe_adds_its_closed_form_to_every_displacement() {
+    let t = 0.4;
+    let mut d = base();
+    d.effects.seating_toe = t;
+    let (r0, r1) = (run(&base(), &law()), run(&d, &law()));
+    assert_eq!(r1.rows(), r0.rows());
+    let (x0, x1, p0) = (col(&r0, columns::DISPLACEMENT), col(&r1, columns::DISPLACEMENT), col(&r0, columns::LOAD));
+    assert_eq!(col(&r1, columns::LOAD), p0);
+    // The toe's closed form with the specimen's own initial compliance.
+    let first = p0.iter().position(|&p| p > 0.0).unwrap();
+    let c0 = x0[first] / p0[first];
+    for i in 0..x0.len() {
+        let toe = t * (1.0 - (-c0 * p0[i].abs() / t).exp());
+        assert!((x1[i] - x0[i] - toe).abs() < 1e-12, "row {i}");
     }
 }
 

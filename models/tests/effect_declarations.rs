@@ -13,6 +13,8 @@ fn models() -> Vec<Box<dyn ForwardModel>> {
         Box::new(Dcb::hartlen_dcb01()),
         Box::new(Enf::hartlen_enf03()),
         Box::new(FrpBeam::paper().unwrap()),
+        Box::new(czid_models::dcb_2d::Dcb2d::hartlen_dcb01()),
+        Box::new(czid_models::enf_2d::Enf2d::hartlen_enf03()),
     ]
 }
 

@@ -62,7 +62,9 @@ fn every_bundled_dcb_candidate_at_its_null_value_is_the_base_model_exactly() {
             "machine_compliance",
             "crack_length_offset",
             "displacement_offset",
-            "shear_compliance"
+            "shear_compliance",
+            "load_offset",
+            "seating_toe"
         ]
     );
 }

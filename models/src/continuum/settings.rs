@@ -112,15 +112,21 @@ pub struct ContinuumEffects {
     pub displacement_offset: f64,
     /// Large displacements (total Lagrangian) instead of small strain.
     pub large_rotation: bool,
+    /// Load-cell zero offset (N): every recorded load is `P + offset`. 0: none.
+    pub load_offset: f64,
+    /// Depth of a smooth seating toe (mm), see [`crate::measurement::Readout`]. 0: none.
+    pub seating_toe: f64,
 }
 
 impl ContinuumEffects {
     /// Checks the values.
     pub fn validate(&self, owner: &str) -> Result<()> {
         require_non_negative(owner, "effects.machine_compliance", self.machine_compliance)?;
+        require_non_negative(owner, "effects.seating_toe", self.seating_toe)?;
         for (name, v) in [
             ("effects.crack_length_offset", self.crack_length_offset),
             ("effects.displacement_offset", self.displacement_offset),
+            ("effects.load_offset", self.load_offset),
         ] {
             if !v.is_finite() {
                 return Err(CzError::invalid(owner, name, v, "must be finite"));
@@ -131,28 +137,44 @@ impl ContinuumEffects {
 
     /// The effects a continuum model declares (`large`: whether it offers large displacements).
     pub fn declarations(large: bool) -> Vec<EffectDeclaration> {
-        use crate::measurement::{DISPLACEMENT_OFFSET, MACHINE_COMPLIANCE};
+        use crate::measurement::{DISPLACEMENT_OFFSET, LOAD_OFFSET, MACHINE_COMPLIANCE, SEATING_TOE};
         let mut out = Vec::new();
         if large {
             out.push(crate::effects::LARGE_ROTATION);
         }
-        out.extend([MACHINE_COMPLIANCE, crate::effects::CRACK_LENGTH_OFFSET, DISPLACEMENT_OFFSET]);
+        out.extend([
+            MACHINE_COMPLIANCE,
+            crate::effects::CRACK_LENGTH_OFFSET,
+            DISPLACEMENT_OFFSET,
+            LOAD_OFFSET,
+            SEATING_TOE,
+        ]);
         out
+    }
+
+    /// How the instruments read the specimen (the measurement effects but the machine's).
+    pub fn readout(&self) -> crate::measurement::Readout {
+        crate::measurement::Readout {
+            displacement_offset: self.displacement_offset,
+            load_offset: self.load_offset,
+            seating_toe: self.seating_toe,
+        }
     }
 }
 
 /// The record of `rows` scaled into the specimen's displacement, load and energies.
 pub fn record(rows: &[Row], s: &RowScale) -> Record {
     let mut rec = beamtest::new_record();
-    if s.offset > 0.0 {
+    let readings = s.readings(rows.iter().map(|r| (r.control, r.reaction)));
+    let unloaded = readings.len() > rows.len();
+    if unloaded {
         let tip = rows.first().map_or(0.0, |r| r.crack.tip);
-        rec.push(&[0.0, 0.0, 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
+        rec.push(&[readings[0][0], readings[0][1], 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
     }
-    for r in rows {
-        let p = s.load * r.reaction;
+    for (r, [delta, p]) in rows.iter().zip(&readings[usize::from(unloaded)..]) {
         rec.push(&[
-            s.displacement * r.control + s.compliance * p + s.offset,
-            p,
+            *delta,
+            *p,
             r.crack.debonded,
             r.crack.process_zone,
             r.crack.tip,

@@ -457,7 +457,7 @@ impl FrpPull {
             .collect();
         beamtest::to_record(
             &rows,
-            &RowScale { displacement: -1.0, offset: 0.0, compliance: 0.0, load: -1.0, energy: 1.0 },
+            &RowScale { displacement: -1.0, compliance: 0.0, load: -1.0, energy: 1.0, readout: Default::default() },
         )
     }
 
