@@ -85,6 +85,13 @@ fn a_small_diagnosis_writes_its_report_and_never_clobbers_it() {
     assert!(o.status.success(), "{}", stderr(&o));
     let gap: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("gap.json")).unwrap()).unwrap();
     assert!(gap["verdict"].as_str().unwrap().len() > 20);
+    // The machine-readable verdict and the model-form floor (the continuum DCB as reference).
+    assert!(
+        ["cause", "none_needed", "unexplained"].contains(&gap["outcome"]["kind"].as_str().unwrap()),
+        "{}",
+        gap["outcome"]
+    );
+    assert_eq!(gap["model_form"]["reference"]["dcb01"], "dcb_2d", "{}", gap["model_form"]);
     assert_eq!(gap["candidates"].as_array().unwrap().len(), 2);
     assert!(gap["regimes"].as_array().unwrap().len() >= 2);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();

@@ -8,7 +8,7 @@ use czid_models::laws::Bilinear;
 use czid_problems::data::Experiment;
 use czid_problems::diagnose::regimes::{self, NAMES};
 use czid_problems::diagnose::run::{diagnose_subject, Subject};
-use czid_problems::diagnose::{CandidateEffect, Library, Options};
+use czid_problems::diagnose::{CandidateEffect, Kind, Library, Options};
 use czid_problems::identification::Setup;
 use czid_problems::synthetic::{synthesize, Noise};
 use std::collections::BTreeMap;
@@ -127,9 +127,17 @@ fn regimes_split_where_the_hand_analysis_puts_them() {
     assert_eq!(rising.iter().map(|g| g.name.as_str()).collect::<Vec<_>>(), NAMES[..2]);
 }
 
-/// A synthetic test of the DCB with a bridging tail of `bridging` MPa (0: none), diagnosed with
-/// the base model from a start 5 % of the ranges away from the truth.
+/// A synthetic test of the DCB with a bridging tail of `bridging` MPa (0: none), made by the beam
+/// model itself, diagnosed with it from a start 5 % of the ranges away from the truth.
 fn diagnose_synthetic(bridging: f64) -> czid_problems::diagnose::Diagnosis {
+    diagnose_made_by(bridging, false)
+}
+
+/// As [`diagnose_synthetic`], the test made by the beam model or by a continuum model of the same
+/// specimen, finer than the beam model's reference (half its interface element, six elements
+/// through each arm). A beam-made test has no model-form misfit: it is diagnosed without the
+/// model-form floor, which would otherwise add the continuum's difference to it.
+fn diagnose_made_by(bridging: f64, continuum: bool) -> czid_problems::diagnose::Diagnosis {
     let base = dcb_setup(16.0, 60);
     let library = Library::builtin();
     let truth = if bridging > 0.0 {
@@ -137,7 +145,20 @@ fn diagnose_synthetic(bridging: f64) -> czid_problems::diagnose::Diagnosis {
     } else {
         base.duplicate().unwrap()
     };
-    let record = truth.models["dcb"].simulate(truth.law.as_ref()).unwrap();
+    let record = if continuum {
+        let beam: Dcb = serde_json::from_value({
+            let mut v = serde_json::to_value(truth.models["dcb"].as_ref()).unwrap();
+            v.as_object_mut().unwrap().remove("type");
+            v
+        })
+        .unwrap();
+        let mut made = czid_models::dcb_2d::Dcb2d::from_beam(&beam).unwrap();
+        made.mesh.interface_element *= 0.5;
+        made.mesh.thickness_elements = 6;
+        made.simulate(truth.law.as_ref()).unwrap()
+    } else {
+        truth.models["dcb"].simulate(truth.law.as_ref()).unwrap()
+    };
     let data = synthesize(&record, 80, Some(16.0), &Noise { load_sd: 0.4, length_sd: 0.3, seed: 11 }).unwrap();
     let experiment = Experiment {
         name: "dcb".into(),
@@ -162,6 +183,7 @@ fn diagnose_synthetic(bridging: f64) -> czid_problems::diagnose::Diagnosis {
             .to_vec(),
         refit: 1,
         holdout: false,
+        model_form: continuum,
         ..Options::default()
     };
     diagnose_subject(&subject, &u0, &library, &opts).unwrap()
@@ -179,6 +201,8 @@ fn a_planted_bridging_tail_ranks_first_and_its_refit_reaches_the_noise() {
     let dof = (d.readings - 5) as f64;
     assert!(czid_problems::diagnose::stats::chi2_survival(refit.chi2, dof) > 1e-3, "{} / {dof}", refit.chi2);
     assert!(d.verdict.contains("Most likely cause: fibre_bridging"), "{}", d.verdict);
+    assert_eq!(d.outcome.kind, Kind::Cause);
+    assert_eq!(d.outcome.cause.as_deref(), Some("fibre_bridging"));
 }
 
 #[test]
@@ -187,4 +211,21 @@ fn a_clean_test_needs_no_unmodelled_effect() {
     assert!(d.base.at_noise_level, "{}", d.base.reduced_chi2);
     assert!(d.candidates.iter().all(|c| !c.score.as_ref().unwrap().significant), "{}", d.verdict);
     assert!(d.verdict.starts_with("No unmodelled effect is needed at this noise level"), "{}", d.verdict);
+    assert_eq!(d.outcome.kind, Kind::NoneNeeded);
+}
+
+#[test]
+fn a_clean_test_made_by_the_continuum_model_needs_no_unmodelled_effect_once_the_model_form_is_accounted_for() {
+    let d = diagnose_made_by(0.0, true);
+    assert!(d.model_form.applied(), "{:?}", d.model_form.note);
+    assert_eq!(d.model_form.reference["dcb"], "dcb_2d");
+    // The beam model's form alone sits well away from the continuum's at this noise…
+    assert!(d.model_form.shift_max > 1.0, "{:?}", d.model_form);
+    // …and once that is accounted for, no effect is named.
+    assert_eq!(d.outcome.kind, Kind::NoneNeeded, "{}", d.verdict);
+    assert!(
+        d.verdict.starts_with("No unmodelled effect is needed at this noise and model-form level"),
+        "{}",
+        d.verdict
+    );
 }

@@ -32,9 +32,14 @@ pub struct DiagnoseArgs {
     /// Candidate effects to score, comma separated (default: every one that applies).
     #[arg(long, value_delimiter = ',')]
     pub candidates: Vec<String>,
-    /// How many of the best-scoring candidates to refit.
-    #[arg(long, default_value_t = 3)]
+    /// At most how many significant candidates to refit (best score first); the cause is decided
+    /// on the refits.
+    #[arg(long, default_value_t = 5)]
     pub refit: usize,
+    /// Judge the candidates against the noise alone, without accounting for the misfit the base
+    /// model's form leaves (estimated with its reference model, e.g. the continuum DCB).
+    #[arg(long)]
+    pub no_model_form: bool,
     /// Other problem files (e.g. other specimens) predicted with the calibrated parameters, with
     /// and without the effect, comma separated.
     #[arg(long, value_delimiter = ',')]
@@ -93,6 +98,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<(), CzError> {
         withheld,
         holdout: !args.no_holdout,
         always_refit: Vec::new(),
+        model_form: !args.no_model_form,
         progress: Some(Box::new(move |m: &str| eprintln!("[{:6.1} s] {m}", clock.elapsed().as_secs_f64()))),
     };
     let d = diagnose::diagnose(&problem, &library, &opts)?;

@@ -24,3 +24,5 @@ pub mod stats;
 pub use candidate::{BridgingTail, CandidateEffect, Declared, EffectParameter, Library};
 pub use gauge::{Gauge, NoiseLevels};
 pub use run::{diagnose, Diagnosis, Options};
+pub use stages::model_form::ModelForm;
+pub use stages::verdict::{Kind, Outcome};

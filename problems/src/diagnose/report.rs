@@ -39,9 +39,16 @@ fn plots(d: &Diagnosis, out: &OutputDir) -> Result<Vec<String>> {
         files.push(name);
 
         let column = b.term.column();
+        let accounted = d.model_form.applied();
         let mut fit =
-            Figure::new(&format!("{}: {what}", b.experiment), "displacement (mm)", &format!("{what} ({unit})"))
-                .with(Series::points("test", b.x.clone(), b.y.clone()));
+            Figure::new(&format!("{}: {what}", b.experiment), "displacement (mm)", &format!("{what} ({unit})")).with(
+                Series::points(if accounted { "test, model form accounted" } else { "test" }, b.x.clone(), b.y.clone()),
+            );
+        if let (true, Some(m)) = (accounted, &d.measured) {
+            if let Some(mb) = m.blocks.iter().find(|mb| mb.experiment == b.experiment && mb.term == b.term) {
+                fit = fit.with(Series::points("test as measured", mb.x.clone(), mb.y.clone()));
+            }
+        }
         if let Some(rec) = d.base_records.get(&b.experiment) {
             let c = rec.curve(columns::DISPLACEMENT, column)?;
             fit = fit.with(Series::line("base fit", c.x().to_vec(), c.y().to_vec()));
@@ -106,7 +113,9 @@ pub fn markdown(d: &Diagnosis, plots: &[String]) -> String {
     let _ = writeln!(s, "# Sim-to-real gap: {}\n", d.problem);
     let _ = writeln!(s, "**Verdict.** {}\n", d.verdict);
     let _ = writeln!(s, "{} readings; diagnosis took {:.1} s.\n", d.readings, d.wall_seconds);
+    outcome_section(&mut s, d);
     noise_section(&mut s, d);
+    model_form_section(&mut s, d);
     base_section(&mut s, d);
     where_section(&mut s, d);
     which_section(&mut s, d);
@@ -118,6 +127,49 @@ pub fn markdown(d: &Diagnosis, plots: &[String]) -> String {
         }
     }
     s
+}
+
+/// The machine-readable verdict, as a table.
+fn outcome_section(s: &mut String, d: &Diagnosis) {
+    let o = &d.outcome;
+    let kind = serde_json::to_value(o.kind).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default();
+    let _ = writeln!(s, "| kind | cause | shrinkage | transfer | confusable with | more missing | provisional |\n|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        s,
+        "| {kind} | {} | {} | {} | {} | {} | {} |\n",
+        o.cause.clone().unwrap_or_else(|| "–".into()),
+        o.shrinkage.map_or("–".into(), |v| format!("{:.0}%", 100.0 * v)),
+        o.transfer_shrinkage.map_or("–".into(), |v| format!("{:.0}%", 100.0 * v)),
+        if o.confusable_with.is_empty() { "–".into() } else { o.confusable_with.join(", ") },
+        if o.more_missing { "yes" } else { "no" },
+        if o.provisional { "yes" } else { "no" }
+    );
+    for r in &o.reasons {
+        let _ = writeln!(s, "* {r}");
+    }
+}
+
+/// The model-form floor.
+fn model_form_section(s: &mut String, d: &Diagnosis) {
+    let f = &d.model_form;
+    let _ = writeln!(s, "\n## Model form\n");
+    match &f.note {
+        Some(note) => {
+            let _ = writeln!(s, "Not accounted for: {note}. Candidates are judged against the noise alone.");
+        }
+        None => {
+            let refs: Vec<String> = f.reference.iter().map(|(e, m)| format!("{e}: `{m}`")).collect();
+            let _ = writeln!(
+                s,
+                "The base fit run through the reference model ({}) differs from it by {:.2} noise units RMS ({:.2} at most): the misfit the base model's form leaves on any test. With that shift accounted for, the base fit's χ² goes from {:.1} to {:.1}; the candidates below are judged on the accounted data.",
+                refs.join(", "),
+                f.shift_rms,
+                f.shift_max,
+                f.chi2_as_measured,
+                f.chi2_accounted
+            );
+        }
+    }
 }
 
 /// Noise per response.
@@ -224,6 +276,9 @@ fn which_section(s: &mut String, d: &Diagnosis) {
     }
     for (name, why) in &d.skipped {
         let _ = writeln!(s, "\n`{name}`: {why}.");
+    }
+    if !d.base.at_bound.is_empty() {
+        let _ = writeln!(s, "\nAt a bound after the restarts: {}.", d.base.at_bound.join(", "));
     }
     if !d.confusable.is_empty() {
         let _ = writeln!(s, "\nConfusable pairs (cosine of their sensitivities beyond the fitted parameters):\n");

@@ -4,7 +4,9 @@ use crate::diagnose::candidate::Library;
 use crate::diagnose::gauge::{Gauge, NoiseLevels};
 use crate::diagnose::regimes::{self, Regime, RegimeMisfit};
 use crate::diagnose::score::Score;
+use crate::diagnose::stages::model_form::{self, ModelForm};
 use crate::diagnose::stages::transfer::{Holdout, Withheld};
+use crate::diagnose::stages::verdict::{self as decide, Outcome};
 use crate::diagnose::stages::{base, ranking, refit};
 use crate::identification::{Setup, Term};
 use crate::identify::optimize;
@@ -15,7 +17,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 /// Significance of the base misfit against the noise (χ² with n − p degrees of freedom).
-const NOISE_LEVEL: f64 = 1e-3;
+pub const NOISE_LEVEL: f64 = 1e-3;
 /// Cosine above which two candidates are reported as confusable.
 pub const CONFUSABLE: f64 = 0.9;
 
@@ -29,7 +31,8 @@ pub struct Options {
     /// Fitted values to start from (physical, in the problem's parameter order), e.g. from an
     /// `identify` result; `None`: fit with the problem file's optimizer first.
     pub start: Option<Vec<f64>>,
-    /// How many of the best-scoring candidates to refit.
+    /// At most how many significant candidates to refit (best score first); every significant
+    /// one up to this number is refitted, and the cause is decided on the refits.
     pub refit: usize,
     /// Noise levels instead of estimates from the data.
     pub noise: NoiseLevels,
@@ -40,6 +43,9 @@ pub struct Options {
     pub holdout: bool,
     /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
     pub always_refit: Vec<String>,
+    /// Account for the model-form misfit with the models' reference models
+    /// ([`stages::model_form`]) before judging any candidate.
+    pub model_form: bool,
     /// Called with a short message as each stage starts (e.g. for a progress display).
     pub progress: Option<ProgressFn>,
 }
@@ -49,11 +55,12 @@ impl Default for Options {
         Options {
             candidates: Vec::new(),
             start: None,
-            refit: 3,
+            refit: 5,
             noise: NoiseLevels::default(),
             withheld: Vec::new(),
             holdout: true,
             always_refit: Vec::new(),
+            model_form: true,
             progress: None,
         }
     }
@@ -115,6 +122,9 @@ pub struct BaseFit {
     pub evaluations: usize,
     /// Runs that stopped early at the fit.
     pub failures: Vec<String>,
+    /// Fitted parameters that sit at a bound of their range after the restarts (the truth may
+    /// lie beyond it, or the fit is lost).
+    pub at_bound: Vec<String>,
 }
 
 /// Shrinkage of the misfit in one regime.
@@ -242,6 +252,10 @@ pub struct Diagnosis {
     pub confusable: Vec<Confusable>,
     /// Every pair's cosine (beyond the fitted parameters' span).
     pub pairs: Vec<Confusable>,
+    /// The model-form floor.
+    pub model_form: ModelForm,
+    /// The verdict, machine-readable.
+    pub outcome: Outcome,
     /// Plain-words verdict.
     pub verdict: String,
     /// Wall time (s).
@@ -255,9 +269,12 @@ pub struct Diagnosis {
     /// Residuals of the base fit (noise units, blocks as in the gauge).
     #[serde(skip)]
     pub base_residuals: Vec<f64>,
-    /// The gauge.
+    /// The gauge (its data with the model-form shift when it was accounted for).
     #[serde(skip)]
     pub gauge: Option<Gauge>,
+    /// The data as measured (for plots).
+    #[serde(skip)]
+    pub measured: Option<Gauge>,
 }
 
 struct Quiet;
@@ -344,8 +361,24 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     };
     let chosen = library.select(&subject.setup, &opts.candidates)?;
     let gauge = Gauge::new(&subject.experiments, subject.use_length, opts.noise)?;
+    let measured = gauge.clone();
     say("polishing the base fit on the misfit in noise units");
-    let base = base::fit(subject, u0, gauge)?;
+    let first = base::fit(subject, u0, gauge)?;
+    let (base, model_form) = if opts.model_form {
+        say("the model-form floor: the base fit run through the reference model");
+        match model_form::account(&first)? {
+            (Some(accounted), mut form) => {
+                say("polishing the base fit with the model-form misfit accounted for");
+                let b = base::fit(subject, &first.u, accounted)?;
+                form.chi2_accounted = b.chi2;
+                (b, form)
+            }
+            (None, form) => (first, form),
+        }
+    } else {
+        let chi2 = first.chi2;
+        (first, ModelForm::not_estimated(chi2, "not asked for".into()))
+    };
     // Where.
     let regs = regimes::split_setup(&base.gauge, &base.setup, &subject.experiments);
     let by_regime = regimes::misfit_by_regime(&base.gauge, &regs, &base.misfit);
@@ -357,8 +390,9 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     // How far, and transfer.
     let holdout = Holdout::prepare(&base, &regs, &lin, opts.holdout, &say)?;
     let withheld = Withheld::prepare(&base, &opts.withheld, opts.noise)?;
-    let mut best_records = None;
-    for i in ranking.to_refit(opts.refit, &opts.always_refit) {
+    let mut refits = BTreeMap::new();
+    let above_noise = base.p_noise <= NOISE_LEVEL;
+    for i in ranking.to_refit(opts.refit, above_noise, &opts.always_refit) {
         let entry = &mut ranking.ranked[i];
         let c = entry.effect.clone();
         say(&format!("refitting with {}", c.name()));
@@ -379,9 +413,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         let x: Vec<f64> = report.parameters.iter().map(|v| v.value).collect();
         entry.result.transfer.extend(withheld.iter().map(|w| w.predict(c.as_ref(), &x, &effect)));
         entry.result.refit = Some(report);
-        if best_records.is_none() {
-            best_records = Some((c.name().to_string(), out.misfit.records));
-        }
+        refits.insert(c.name().to_string(), out.misfit.records);
     }
     let ranking::Ranking { ranked, skipped, pairs, confusable } = ranking;
     let candidates: Vec<CandidateResult> = ranked.into_iter().map(|r| r.result).collect();
@@ -393,8 +425,11 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         at_noise_level: base.p_noise > NOISE_LEVEL,
         evaluations: base.evaluations,
         failures: base.misfit.failures.clone(),
+        at_bound: base::at_bound(&base.u).into_iter().map(|j| base.space.parameters()[j].path.clone()).collect(),
     };
-    let verdict = verdict(&base_fit, &by_regime, &candidates, &confusable);
+    let outcome = decide::decide(&base_fit, base.readings(), &candidates, &confusable);
+    let verdict = decide::text(&base_fit, &model_form, &by_regime, &candidates, &outcome);
+    let best_records = outcome.cause.as_ref().and_then(|c| refits.remove(c).map(|r| (c.clone(), r)));
     let noise = base
         .gauge
         .blocks
@@ -419,104 +454,14 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         skipped,
         confusable,
         pairs,
+        model_form,
+        outcome,
         verdict,
         wall_seconds: clock.elapsed().as_secs_f64(),
         base_records: base.misfit.records,
         best_records,
         base_residuals: base.misfit.r,
         gauge: Some(base.gauge),
+        measured: Some(measured),
     })
-}
-
-fn pct(v: f64) -> String {
-    format!("{:.0}%", 100.0 * v)
-}
-
-/// The verdict in plain words.
-pub fn verdict(
-    base: &BaseFit,
-    misfit: &[RegimeMisfit],
-    candidates: &[CandidateResult],
-    confusable: &[Confusable],
-) -> String {
-    let mut out = String::new();
-    if let Some(m) = misfit.iter().max_by(|a, b| a.share.total_cmp(&b.share)) {
-        let what = m.term.noun();
-        out.push_str(&format!(
-            "The misfit sits mostly in the {} regime of {} ({} of it; {what}: {}, mean test − model {:+.3} {}).",
-            m.regime,
-            m.experiment,
-            pct(m.share),
-            m.sign,
-            m.mean,
-            m.unit
-        ));
-    }
-    let best = candidates.first().and_then(|c| c.score.as_ref().map(|s| (c, s)));
-    match best {
-        Some((c, s)) if s.significant => {
-            out.push_str(&format!(
-                " Most likely cause: {} ({}); to first order it explains {} of the misfit (score {:.1}, p = {:.1e}).",
-                c.name, c.description, pct(s.explained), s.statistic, s.p_value
-            ));
-            if let Some(r) = &c.refit {
-                out.push_str(&format!(
-                    " Adding it removes {} of the misfit (ΔBIC = {:.1}).",
-                    pct(r.shrinkage),
-                    r.delta_bic
-                ));
-            }
-            for t in &c.transfer {
-                match t.shrinkage {
-                    Some(sh) if sh >= 0.0 => {
-                        out.push_str(&format!(" On withheld data ({}) it removes {}.", t.withheld, pct(sh)))
-                    }
-                    Some(sh) => out.push_str(&format!(
-                        " On withheld data ({}) it makes the prediction worse (misfit +{}).",
-                        t.withheld,
-                        pct(-sh)
-                    )),
-                    None => out.push_str(&format!(
-                        " Withheld data ({}): {}.",
-                        t.withheld,
-                        t.note.clone().unwrap_or_default()
-                    )),
-                }
-            }
-            if let (Some(by), Some(shift)) = (&s.absorbed_by, s.absorbed_shift) {
-                out.push_str(&format!(" Without it, {by} absorbs it (first-order shift {shift:+.4e}"));
-                let before = base.parameters.iter().find(|q| &q.path == by);
-                let after = c.refit.as_ref().and_then(|r| r.parameters.iter().find(|q| &q.name == by));
-                if let (Some(b), Some(a)) = (before, after) {
-                    out.push_str(&format!("; the refit moves it from {:.4e} to {:.4e} {}", b.value, a.value, b.unit));
-                }
-                out.push_str(").");
-            }
-            let twins: Vec<String> = confusable
-                .iter()
-                .filter(|p| p.a == c.name || p.b == c.name)
-                .map(|p| if p.a == c.name { p.b.clone() } else { p.a.clone() })
-                .collect();
-            if !twins.is_empty() {
-                out.push_str(&format!(" These data can hardly tell it from {}.", twins.join(", ")));
-            }
-            if !base.at_noise_level {
-                if let Some(r) = &c.refit {
-                    if r.chi2 / base.chi2.max(f64::MIN_POSITIVE) * base.reduced_chi2 > 2.0 {
-                        out.push_str(" Even with it the misfit stays well above the noise: more is missing.");
-                    }
-                }
-            }
-        }
-        _ if base.at_noise_level => out = format!(
-            "No unmodelled effect is needed at this noise level: the base model fits to χ²/dof = {:.2} and no candidate scores significantly.",
-            base.reduced_chi2
-        ),
-        Some((c, s)) => out.push_str(&format!(
-            " The misfit exceeds the noise (χ²/dof = {:.1}) but no candidate explains a significant part of it; the best, {}, explains {}.",
-            base.reduced_chi2, c.name, pct(s.explained)
-        )),
-        None => out.push_str(" No candidate effect could be scored."),
-    }
-    out
 }

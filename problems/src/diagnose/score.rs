@@ -98,31 +98,33 @@ pub struct Sensitivity {
 type Eval = (usize, f64, std::result::Result<Vec<f64>, String>);
 
 /// The evaluation points a candidate needs for its sensitivity: `(parameter, unit value)`.
-fn points(params: &[EffectParameter], discrete: bool) -> Vec<(usize, f64)> {
+fn points(params: &[EffectParameter], discrete: bool, step: f64) -> Vec<(usize, f64)> {
     let mut out = Vec::new();
     for (j, p) in params.iter().enumerate() {
         let u = p.parameter.to_unit(p.null);
         if discrete {
             out.push((j, 1.0));
         } else if u <= 0.0 {
-            out.push((j, u + EFFECT_STEP));
+            out.push((j, u + step));
         } else if u >= 1.0 {
-            out.push((j, u - EFFECT_STEP));
+            out.push((j, u - step));
         } else {
-            out.push((j, u - EFFECT_STEP));
-            out.push((j, u + EFFECT_STEP));
+            out.push((j, u - step));
+            out.push((j, u + step));
         }
     }
     out
 }
 
 /// Sensitivities of `candidates` at the fitted setup (its residuals `r0` on `gauge`), every
-/// simulation run in parallel. A candidate whose runs fail gets the error instead.
+/// simulation run in parallel, by differences of `step` (unit coordinates of each parameter's
+/// range, normally [`EFFECT_STEP`]). A candidate whose runs fail gets the error instead.
 pub fn sensitivities(
     gauge: &Gauge,
     fitted: &Setup,
     r0: &[f64],
     candidates: &[&dyn CandidateEffect],
+    step: f64,
 ) -> Vec<std::result::Result<Sensitivity, String>> {
     let base_tree = serde_json::to_value(fitted).ok();
     // Every (candidate, parameter, value) job, its setup built first, then all simulated at once.
@@ -140,7 +142,7 @@ pub fn sensitivities(
             let params = c.parameters(fitted)?;
             let null: Vec<f64> = params.iter().map(|p| p.null).collect();
             let mut jobs = Vec::new();
-            for (j, u) in points(&params, c.discrete()) {
+            for (j, u) in points(&params, c.discrete(), step) {
                 let mut values = null.clone();
                 values[j] = params[j].parameter.from_unit(u);
                 let setup = c.apply(fitted, &values)?;

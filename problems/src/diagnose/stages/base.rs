@@ -53,15 +53,45 @@ impl Base {
     }
 }
 
-/// Polishes the subject's parameters from `u0` (unit cube) on the misfit in noise units.
+/// Distance to a bound (unit-cube coordinates) below which a fitted parameter sits at the bound.
+const AT_BOUND: f64 = 1e-3;
+/// Where a parameter found at a bound is started again (unit-cube coordinates).
+const RESTARTS: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// Indices of the coordinates of `u` at a bound of the unit cube.
+pub fn at_bound(u: &[f64]) -> Vec<usize> {
+    (0..u.len()).filter(|&j| u[j] < AT_BOUND || u[j] > 1.0 - AT_BOUND).collect()
+}
+
+/// Polishes the subject's parameters from `u0` (unit cube) on the misfit in noise units. A fit
+/// that ends with a parameter at a bound is started again with those parameters at a quarter,
+/// the middle and three quarters of their range, and the best of the fits kept: a local method
+/// stopped against a bound is more often lost than right, and a base fit that is wrong poisons
+/// every later stage.
 pub fn fit(subject: &Subject, u0: &[f64], gauge: Gauge) -> Result<Base> {
     let space = subject.space.clone();
     let setup = subject.setup.duplicate()?;
-    let polish = {
-        let f =
-            |u: &[f64]| -> Result<Vec<f64>> { Ok(Misfit::of(&gauge, &space.apply(&setup, &space.from_unit(u))?)?.r) };
-        least_squares::minimize(&Parallel(f), u0, &LmOptions::unit_cube(space.dim(), POLISH_STEP), None)?
+    let f = |u: &[f64]| -> Result<Vec<f64>> { Ok(Misfit::of(&gauge, &space.apply(&setup, &space.from_unit(u))?)?.r) };
+    let lm = |start: &[f64]| {
+        least_squares::minimize(&Parallel(f), start, &LmOptions::unit_cube(space.dim(), POLISH_STEP), None)
     };
+    let mut polish = lm(u0)?;
+    let mut evaluations = polish.evaluations;
+    let stuck = at_bound(&polish.z);
+    if !stuck.is_empty() {
+        for w in RESTARTS {
+            let mut start = polish.z.clone();
+            for &j in &stuck {
+                start[j] = w;
+            }
+            if let Ok(again) = lm(&start) {
+                evaluations += again.evaluations;
+                if again.cost < polish.cost {
+                    polish = again;
+                }
+            }
+        }
+    }
     let u = polish.z;
     let x = space.from_unit(&u);
     let fitted = space.apply(&setup, &x)?;
@@ -69,7 +99,7 @@ pub fn fit(subject: &Subject, u0: &[f64], gauge: Gauge) -> Result<Base> {
     let chi2 = misfit.rss();
     let dof = gauge.len().saturating_sub(space.dim()).max(1);
     let p_noise = chi2_survival(chi2, dof as f64);
-    Ok(Base { space, setup, gauge, u, x, fitted, misfit, chi2, dof, p_noise, evaluations: polish.evaluations })
+    Ok(Base { space, setup, gauge, u, x, fitted, misfit, chi2, dof, p_noise, evaluations })
 }
 
 /// What the data say about the fitted parameters: standard errors, sensitivities and verdicts,

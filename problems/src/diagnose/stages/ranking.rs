@@ -8,6 +8,9 @@ use crate::diagnose::run::{CandidateResult, Confusable, CONFUSABLE};
 use crate::diagnose::score::{self, Linearisation, Sensitivity};
 use std::sync::Arc;
 
+/// How much smaller the step of a second try at a failed candidate's sensitivity is.
+const RETRY_STEP: f64 = 4.0;
+
 /// A candidate with its result so far and, when it could be evaluated, its sensitivity.
 pub struct Ranked {
     /// The effect.
@@ -47,7 +50,19 @@ pub fn rank(base: &Base, lin: &Linearisation, chosen: Vec<Arc<dyn CandidateEffec
         })
         .collect();
     let effects: Vec<&dyn CandidateEffect> = applicable.iter().map(|c| c.as_ref()).collect();
-    let sens = score::sensitivities(&base.gauge, &base.fitted, &base.misfit.r, &effects);
+    let mut sens = score::sensitivities(&base.gauge, &base.fitted, &base.misfit.r, &effects, score::EFFECT_STEP);
+    // A candidate whose runs failed is tried again closer to its null value (a run at a smaller
+    // effect is more often one the model can follow); if it fails again, it is reported as not
+    // evaluated and the verdict is provisional.
+    let failed: Vec<usize> = (0..sens.len()).filter(|&i| sens[i].is_err()).collect();
+    if !failed.is_empty() {
+        let again: Vec<&dyn CandidateEffect> = failed.iter().map(|&i| effects[i]).collect();
+        let retried =
+            score::sensitivities(&base.gauge, &base.fitted, &base.misfit.r, &again, score::EFFECT_STEP / RETRY_STEP);
+        for (&i, r) in failed.iter().zip(retried) {
+            sens[i] = r.map_err(|e| format!("{e} (also with a {RETRY_STEP}× smaller step)"));
+        }
+    }
     let tests = applicable.len();
     let mut ranked: Vec<Ranked> = applicable
         .iter()
@@ -86,13 +101,23 @@ pub fn rank(base: &Base, lin: &Linearisation, chosen: Vec<Arc<dyn CandidateEffec
 }
 
 impl Ranking {
-    /// Indices of the candidates to refit: the `refit` best scored ones, plus any named in
-    /// `always` (e.g. a benchmark's planted effect).
-    pub fn to_refit(&self, refit: usize, always: &[String]) -> Vec<usize> {
+    /// Indices of the candidates to refit: every significant one, best score first, up to
+    /// `refit`; when the base fit is `above_noise`, the two best scored at least (an effect the
+    /// first-order score underrates may still remove the misfit); plus any named in `always`
+    /// (e.g. a benchmark's planted effect).
+    pub fn to_refit(&self, refit: usize, above_noise: bool, always: &[String]) -> Vec<usize> {
         let scored: Vec<usize> = (0..self.ranked.len())
             .filter(|&i| self.ranked[i].result.score.as_ref().is_some_and(|s| s.dof > 0))
             .collect();
-        let mut top: Vec<usize> = scored.iter().copied().take(refit).collect();
+        let significant = |i: &usize| self.ranked[*i].result.score.as_ref().is_some_and(|s| s.significant);
+        let mut top: Vec<usize> = scored.iter().copied().filter(significant).take(refit).collect();
+        if above_noise {
+            for &i in scored.iter().take(2) {
+                if !top.contains(&i) {
+                    top.push(i);
+                }
+            }
+        }
         let extra: Vec<usize> = scored
             .iter()
             .copied()

@@ -1,0 +1,244 @@
+//! The verdict: decided on the refits' evidence, not on the first-order scores.
+//!
+//! A score says which candidates point the right way at the base fit; only a refit says how much
+//! of the misfit an effect removes once the fitted parameters move with it. The named cause is
+//! the refitted candidate that removes most of the misfit, provided its refit is worth its
+//! parameters by a clear margin (ΔBIC below −[`EVIDENCE`]) and it does not predict withheld data
+//! worse. With no such candidate, the answer is "no unmodelled effect is needed" when the base fit
+//! is at the noise level, and "the misfit has structure no candidate removes" when it is not.
+
+use crate::diagnose::regimes::RegimeMisfit;
+use crate::diagnose::run::{BaseFit, CandidateResult, Confusable, NOISE_LEVEL};
+use crate::diagnose::stages::model_form::ModelForm;
+use crate::diagnose::stats::chi2_survival;
+use serde::Serialize;
+
+/// ΔBIC a refit must reach (below minus this) to count as evidence: "very strong" on Kass and
+/// Raftery's scale, so that a candidate that only soaks up noise (or a model-form misfit left
+/// over) is not named.
+pub const EVIDENCE: f64 = 10.0;
+/// A refitted cause that predicts withheld data this much worse than the base model is rejected.
+const TRANSFER_WORSE: f64 = -0.1;
+
+/// What kind of answer the diagnosis gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kind {
+    /// An effect explains the misfit.
+    Cause,
+    /// The base model fits at the noise (and model-form) level: no effect is needed.
+    NoneNeeded,
+    /// The misfit exceeds the noise and no candidate removes it.
+    Unexplained,
+}
+
+/// The verdict, machine-readable (`gap.json`'s `outcome`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Outcome {
+    /// Cause, none needed or unexplained.
+    pub kind: Kind,
+    /// The named cause.
+    pub cause: Option<String>,
+    /// Share of the misfit its refit removes.
+    pub shrinkage: Option<f64>,
+    /// Share of the misfit of withheld data it removes (the first transfer check that ran).
+    pub transfer_shrinkage: Option<f64>,
+    /// Candidates the data can hardly tell from the cause (cosine above the confusable level).
+    pub confusable_with: Vec<String>,
+    /// Whether the misfit left with the cause still exceeds the noise: more is missing.
+    pub more_missing: bool,
+    /// Whether the verdict may change once what stopped it is fixed (a candidate that could not
+    /// be evaluated, a fitted parameter at a bound, base runs that stopped early).
+    pub provisional: bool,
+    /// Why it is provisional, and candidates set aside.
+    pub reasons: Vec<String>,
+}
+
+/// Degrees of freedom left by a refit of `r` fitted and effect parameters on `n` readings.
+fn refit_dof(n: usize, c: &CandidateResult) -> f64 {
+    let k = c.refit.as_ref().map_or(0, |r| r.parameters.len() + r.effect.len());
+    n.saturating_sub(k).max(1) as f64
+}
+
+/// Decides the verdict from the base fit and the refitted candidates; `n` is the number of
+/// readings.
+pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusable: &[Confusable]) -> Outcome {
+    let mut reasons = Vec::new();
+    for c in candidates {
+        if let Some(e) = &c.error {
+            reasons.push(format!("{} could not be evaluated: {e}", c.name));
+        }
+    }
+    for p in &base.at_bound {
+        reasons.push(format!("the base fit's {p} sits at a bound of its range"));
+    }
+    if !base.failures.is_empty() {
+        reasons.push(format!("base runs stopped early: {}", base.failures.join("; ")));
+    }
+    let provisional = !reasons.is_empty();
+    let mut best: Option<&CandidateResult> = None;
+    for c in candidates {
+        let Some(r) = &c.refit else { continue };
+        if r.delta_bic > -EVIDENCE {
+            continue;
+        }
+        if let Some(t) = c.transfer.iter().find_map(|t| t.shrinkage.filter(|&s| s < TRANSFER_WORSE)) {
+            reasons.push(format!(
+                "{} removes {:.0}% of the misfit but predicts withheld data worse (misfit +{:.0}%)",
+                c.name,
+                100.0 * r.shrinkage,
+                -100.0 * t
+            ));
+            continue;
+        }
+        if best.and_then(|b| b.refit.as_ref()).is_none_or(|b| r.shrinkage > b.shrinkage) {
+            best = Some(c);
+        }
+    }
+    match best {
+        Some(c) => {
+            let r = c.refit.as_ref().expect("refitted");
+            let confusable_with = confusable
+                .iter()
+                .filter(|p| p.a == c.name || p.b == c.name)
+                .map(|p| if p.a == c.name { p.b.clone() } else { p.a.clone() })
+                .collect();
+            Outcome {
+                kind: Kind::Cause,
+                cause: Some(c.name.clone()),
+                shrinkage: Some(r.shrinkage),
+                transfer_shrinkage: c.transfer.iter().find_map(|t| t.shrinkage),
+                confusable_with,
+                more_missing: chi2_survival(r.chi2, refit_dof(n, c)) <= NOISE_LEVEL,
+                provisional,
+                reasons,
+            }
+        }
+        None => Outcome {
+            kind: if base.at_noise_level { Kind::NoneNeeded } else { Kind::Unexplained },
+            cause: None,
+            shrinkage: None,
+            transfer_shrinkage: None,
+            confusable_with: Vec::new(),
+            more_missing: false,
+            provisional,
+            reasons,
+        },
+    }
+}
+
+fn pct(v: f64) -> String {
+    format!("{:.0}%", 100.0 * v)
+}
+
+/// The verdict in plain words.
+pub fn text(
+    base: &BaseFit,
+    form: &ModelForm,
+    misfit: &[RegimeMisfit],
+    candidates: &[CandidateResult],
+    outcome: &Outcome,
+) -> String {
+    let mut out = String::new();
+    let level = if form.applied() { "noise and model-form level" } else { "noise level" };
+    if outcome.kind != Kind::NoneNeeded {
+        if let Some(m) = misfit.iter().max_by(|a, b| a.share.total_cmp(&b.share)) {
+            out.push_str(&format!(
+                "The misfit sits mostly in the {} regime of {} ({} of it; {}: {}, mean test − model {:+.3} {}). ",
+                m.regime,
+                m.experiment,
+                pct(m.share),
+                m.term.noun(),
+                m.sign,
+                m.mean,
+                m.unit
+            ));
+        }
+    }
+    match outcome.kind {
+        Kind::NoneNeeded => out.push_str(&format!(
+            "No unmodelled effect is needed at this {level}: the base model fits to χ²/dof = {:.2} and no candidate's refit is worth its parameters.",
+            base.reduced_chi2
+        )),
+        Kind::Unexplained => {
+            out.push_str(&format!(
+                "The misfit exceeds the {level} (χ²/dof = {:.2}) and has structure no candidate removes",
+                base.reduced_chi2
+            ));
+            let best = candidates
+                .iter()
+                .filter_map(|c| c.refit.as_ref().map(|r| (c, r)))
+                .max_by(|a, b| a.1.shrinkage.total_cmp(&b.1.shrinkage));
+            match best {
+                Some((c, r)) => out.push_str(&format!(
+                    ": the best refit, {}, removes {} of it (ΔBIC = {:.1}).",
+                    c.name,
+                    pct(r.shrinkage),
+                    r.delta_bic
+                )),
+                None => out.push('.'),
+            }
+        }
+        Kind::Cause => cause_text(&mut out, base, candidates, outcome),
+    }
+    if form.applied() {
+        out.push_str(&format!(
+            " (The model-form misfit, estimated with the reference model, was accounted for: χ² {:.0} as measured, {:.0} after.)",
+            form.chi2_as_measured, form.chi2_accounted
+        ));
+    }
+    if outcome.provisional {
+        out.push_str(&format!(" Provisional: {}.", outcome.reasons.join("; ")));
+    }
+    out
+}
+
+fn cause_text(out: &mut String, base: &BaseFit, candidates: &[CandidateResult], outcome: &Outcome) {
+    let Some(c) = candidates.iter().find(|c| Some(&c.name) == outcome.cause.as_ref()) else { return };
+    let Some(r) = &c.refit else { return };
+    out.push_str(&format!(
+        "Most likely cause: {} ({}). Adding it removes {} of the misfit (ΔBIC = {:.1}).",
+        c.name,
+        c.description,
+        pct(r.shrinkage),
+        r.delta_bic
+    ));
+    if let Some(s) = &c.score {
+        out.push_str(&format!(
+            " To first order it explains {} (score {:.1}, p = {:.1e}).",
+            pct(s.explained),
+            s.statistic,
+            s.p_value
+        ));
+    }
+    for t in &c.transfer {
+        match t.shrinkage {
+            Some(sh) if sh >= 0.0 => {
+                out.push_str(&format!(" On withheld data ({}) it removes {}.", t.withheld, pct(sh)))
+            }
+            Some(sh) => out.push_str(&format!(
+                " On withheld data ({}) it makes the prediction worse (misfit +{}).",
+                t.withheld,
+                pct(-sh)
+            )),
+            None => out.push_str(&format!(" Withheld data ({}): {}.", t.withheld, t.note.clone().unwrap_or_default())),
+        }
+    }
+    if let Some(s) = &c.score {
+        if let (Some(by), Some(shift)) = (&s.absorbed_by, s.absorbed_shift) {
+            out.push_str(&format!(" Without it, {by} absorbs it (first-order shift {shift:+.4e}"));
+            let before = base.parameters.iter().find(|q| &q.path == by);
+            let after = r.parameters.iter().find(|q| &q.name == by);
+            if let (Some(b), Some(a)) = (before, after) {
+                out.push_str(&format!("; the refit moves it from {:.4e} to {:.4e} {}", b.value, a.value, b.unit));
+            }
+            out.push_str(").");
+        }
+    }
+    if !outcome.confusable_with.is_empty() {
+        out.push_str(&format!(" These data can hardly tell it from {}.", outcome.confusable_with.join(", ")));
+    }
+    if outcome.more_missing {
+        out.push_str(" Even with it the misfit stays above the noise: more is missing.");
+    }
+}
