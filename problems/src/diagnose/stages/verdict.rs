@@ -242,3 +242,95 @@ fn cause_text(out: &mut String, base: &BaseFit, candidates: &[CandidateResult], 
         out.push_str(" Even with it the misfit stays above the noise: more is missing.");
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::run::{Refit, Transfer};
+
+    fn base(reduced: f64) -> BaseFit {
+        BaseFit {
+            parameters: Vec::new(),
+            chi2: reduced * 398.0,
+            reduced_chi2: reduced,
+            p_value: chi2_survival(reduced * 398.0, 398.0),
+            at_noise_level: chi2_survival(reduced * 398.0, 398.0) > NOISE_LEVEL,
+            evaluations: 0,
+            failures: Vec::new(),
+            at_bound: Vec::new(),
+        }
+    }
+
+    fn candidate(name: &str, refit: Option<(f64, f64, f64)>, transfer: Option<f64>) -> CandidateResult {
+        CandidateResult {
+            name: name.into(),
+            description: String::new(),
+            score: None,
+            error: None,
+            refit: refit.map(|(chi2, shrinkage, delta_bic)| Refit {
+                parameters: Vec::new(),
+                effect: Vec::new(),
+                chi2,
+                shrinkage,
+                by_regime: Vec::new(),
+                aic: 0.0,
+                bic: 0.0,
+                delta_aic: delta_bic,
+                delta_bic,
+                evaluations: 0,
+            }),
+            transfer: transfer
+                .map(|s| Transfer {
+                    withheld: "late stage".into(),
+                    readings: 50,
+                    base_chi2: 1.0,
+                    effect_chi2: Some(1.0 - s),
+                    shrinkage: Some(s),
+                    note: None,
+                })
+                .into_iter()
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn the_cause_is_the_refit_that_removes_most_not_the_best_score() {
+        // Listed best score first: the first one's refit removes little.
+        let cs = [candidate("a", Some((700.0, 0.12, -60.0)), None), candidate("b", Some((400.0, 0.5, -300.0)), None)];
+        let o = decide(&base(2.0), 400, &cs, &[]);
+        assert_eq!((o.kind, o.cause.as_deref()), (Kind::Cause, Some("b")));
+        assert!(!o.more_missing && !o.provisional);
+    }
+
+    #[test]
+    fn without_evidence_the_answer_is_none_needed_or_unexplained() {
+        let weak = [candidate("a", Some((390.0, 0.02, -2.0)), None)];
+        assert_eq!(decide(&base(1.0), 400, &weak, &[]).kind, Kind::NoneNeeded);
+        assert_eq!(decide(&base(3.0), 400, &weak, &[]).kind, Kind::Unexplained);
+        assert_eq!(decide(&base(3.0), 400, &[], &[]).kind, Kind::Unexplained);
+    }
+
+    #[test]
+    fn a_cause_that_predicts_withheld_data_worse_is_set_aside() {
+        let cs = [
+            candidate("a", Some((400.0, 0.6, -400.0)), Some(-0.5)),
+            candidate("b", Some((600.0, 0.4, -200.0)), Some(0.3)),
+        ];
+        let o = decide(&base(2.5), 400, &cs, &[]);
+        assert_eq!(o.cause.as_deref(), Some("b"));
+        assert!(o.reasons.iter().any(|r| r.starts_with("a removes 60%")), "{:?}", o.reasons);
+        assert_eq!(o.transfer_shrinkage, Some(0.3));
+    }
+
+    #[test]
+    fn more_missing_confusable_and_provisional_are_said() {
+        let mut cs = vec![candidate("a", Some((800.0, 0.6, -400.0)), None), candidate("b", None, None)];
+        cs[1].error = Some("the model did not run".into());
+        let pairs = [Confusable { a: "c".into(), b: "a".into(), cos: 0.97 }];
+        let o = decide(&base(5.0), 400, &cs, &pairs);
+        assert_eq!(o.cause.as_deref(), Some("a"));
+        assert!(o.more_missing, "χ² 800 on ~400 readings is above the noise");
+        assert_eq!(o.confusable_with, ["c"]);
+        assert!(o.provisional && o.reasons[0].starts_with("b could not be evaluated"), "{:?}", o.reasons);
+    }
+}
