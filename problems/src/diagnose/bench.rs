@@ -94,6 +94,9 @@ pub struct CaseResult {
     pub refits: Vec<(String, f64, f64)>,
     /// Candidates by score, best first, with whether they are significant.
     pub ranking: Vec<(String, f64, bool)>,
+    /// The base fit's values of the fitted parameters (physical units, as `truth`).
+    #[serde(default)]
+    pub base_fit: Vec<f64>,
     /// χ²/dof of the base fit.
     pub base_reduced_chi2: f64,
     /// Whether the base fit is at the noise level (the planted effect is then undetectable).
@@ -182,6 +185,7 @@ fn case(
         reasons: Vec::new(),
         refits: Vec::new(),
         ranking: Vec::new(),
+        base_fit: Vec::new(),
         base_reduced_chi2: f64::NAN,
         base_at_noise_level: false,
         true_reduced_chi2: None,
@@ -299,6 +303,7 @@ fn with_gain(e: Experiment, g: f64) -> Result<Experiment> {
 /// effect's refit, failures and the candidates' angles.
 fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
     out.base_reduced_chi2 = d.base.reduced_chi2;
+    out.base_fit = d.base.parameters.iter().map(|q| q.value).collect();
     out.base_at_noise_level = d.base.at_noise_level;
     out.ranking = d
         .candidates
@@ -321,8 +326,9 @@ fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
         if let Some(r) = &c.refit {
             out.true_refit = r.effect.iter().map(|v| v.value).collect();
             let dof = d.readings.saturating_sub(r.parameters.len() + r.effect.len()).max(1) as f64;
-            out.true_reduced_chi2 = Some(r.chi2 / dof);
-            out.true_at_noise_level = Some(chi2_survival(r.chi2, dof) > 1e-3);
+            let chi2 = r.chi2_reestimated.unwrap_or(r.chi2);
+            out.true_reduced_chi2 = Some(chi2 / dof);
+            out.true_at_noise_level = Some(chi2_survival(chi2, dof) > 1e-3);
         }
     }
     out.notes = d.candidates.iter().filter_map(|c| c.error.as_ref().map(|e| format!("{}: {e}", c.name))).collect();

@@ -165,6 +165,10 @@ pub struct Refit {
     pub delta_bic: f64,
     /// Residual evaluations.
     pub evaluations: usize,
+    /// χ² once the model-form misfit is estimated again at this refit's fitted parameters and the
+    /// refit polished on it (the named cause only, when the floor applies): what "more is
+    /// missing" is judged on.
+    pub chi2_reestimated: Option<f64>,
 }
 
 /// Prediction of withheld data with and without the effect.
@@ -413,10 +417,10 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         let x: Vec<f64> = report.parameters.iter().map(|v| v.value).collect();
         entry.result.transfer.extend(withheld.iter().map(|w| w.predict(c.as_ref(), &x, &effect)));
         entry.result.refit = Some(report);
-        refits.insert(c.name().to_string(), out.misfit.records);
+        refits.insert(c.name().to_string(), (c.clone(), params, out));
     }
     let ranking::Ranking { ranked, skipped, pairs, confusable } = ranking;
-    let candidates: Vec<CandidateResult> = ranked.into_iter().map(|r| r.result).collect();
+    let mut candidates: Vec<CandidateResult> = ranked.into_iter().map(|r| r.result).collect();
     let base_fit = BaseFit {
         parameters,
         chi2: base.chi2,
@@ -427,9 +431,21 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         failures: base.misfit.failures.clone(),
         at_bound: base::at_bound(&base.u).into_iter().map(|j| base.space.parameters()[j].path.clone()).collect(),
     };
+    let first = decide::decide(&base_fit, base.readings(), &candidates, &confusable);
+    if let (Some(cause), true) = (&first.cause, model_form.applied()) {
+        // The floor was estimated at the base fit, which an effect may have pulled away from the
+        // truth; the cause's refit is judged again with the floor re-estimated at its parameters.
+        if let Some((c, params, out)) = refits.get(cause) {
+            say(&format!("{cause}: the model-form floor re-estimated at its refit"));
+            let chi2 = reestimated(&base, &measured, c.as_ref(), params, out)?;
+            if let Some(r) = candidates.iter_mut().find(|x| &x.name == cause).and_then(|x| x.refit.as_mut()) {
+                r.chi2_reestimated = chi2;
+            }
+        }
+    }
     let outcome = decide::decide(&base_fit, base.readings(), &candidates, &confusable);
     let verdict = decide::text(&base_fit, &model_form, &by_regime, &candidates, &outcome);
-    let best_records = outcome.cause.as_ref().and_then(|c| refits.remove(c).map(|r| (c.clone(), r)));
+    let best_records = outcome.cause.as_ref().and_then(|c| refits.remove(c).map(|r| (c.clone(), r.2.misfit.records)));
     let noise = base
         .gauge
         .blocks
@@ -464,4 +480,20 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         gauge: Some(base.gauge),
         measured: Some(measured),
     })
+}
+
+/// χ² of candidate `c`'s refit `out` polished again on the measured data shifted by the model-form
+/// misfit at the refit's fitted parameters (`None` when that cannot be estimated or the polish
+/// fails).
+fn reestimated(
+    base: &base::Base,
+    measured: &Gauge,
+    c: &dyn crate::diagnose::CandidateEffect,
+    params: &[Parameter],
+    out: &refit::RefitOutcome,
+) -> Result<Option<f64>> {
+    let p = base.space.dim();
+    let fitted = base.space.apply(&base.setup, &base.space.from_unit(&out.v[..p]))?;
+    let Some(gauge) = model_form::account_at(measured, &fitted)? else { return Ok(None) };
+    Ok(refit::refit_on(&gauge, base, c, params, &out.v, out.jacobian.clone()).ok().map(|o| o.misfit.rss()))
 }

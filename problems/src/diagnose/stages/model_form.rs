@@ -98,32 +98,53 @@ pub fn account(base: &Base) -> Result<(Option<Gauge>, ModelForm)> {
         Ok(s) => s,
         Err(note) => return Ok((None, ModelForm::not_estimated(base.chi2, note))),
     };
-    let misfit = Misfit::of(&base.gauge, &setup)?;
-    if !misfit.failures.is_empty() {
-        let note = format!("the reference model stopped early: {}", misfit.failures.join("; "));
-        return Ok((None, ModelForm::not_estimated(base.chi2, note)));
-    }
-    let mut gauge = base.gauge.clone();
-    let mut shift_all = Vec::with_capacity(gauge.len());
-    for (b, range) in gauge.blocks.iter_mut().zip(base.gauge.ranges()) {
-        // (test − reference)/σ − (test − base)/σ = (base − reference)/σ.
-        let raw: Vec<f64> = range.map(|i| misfit.r[i] - base.misfit.r[i]).collect();
-        let shift = smooth(&b.x, &raw);
-        for (y, s) in b.y.iter_mut().zip(&shift) {
-            *y += b.sigma * s;
-        }
-        shift_all.extend(shift);
-    }
-    let n = shift_all.len().max(1) as f64;
+    let shifted = match shift(&base.gauge, &base.misfit.r, &setup)? {
+        Ok(s) => s,
+        Err(note) => return Ok((None, ModelForm::not_estimated(base.chi2, note))),
+    };
+    let n = shifted.1.len().max(1) as f64;
     let form = ModelForm {
         reference,
         chi2_as_measured: base.chi2,
         chi2_accounted: f64::NAN,
-        shift_rms: (shift_all.iter().map(|s| s * s).sum::<f64>() / n).sqrt(),
-        shift_max: shift_all.iter().fold(0.0, |m, s| m.max(s.abs())),
+        shift_rms: (shifted.1.iter().map(|s| s * s).sum::<f64>() / n).sqrt(),
+        shift_max: shifted.1.iter().fold(0.0, |m, s| m.max(s.abs())),
         note: None,
     };
-    Ok((Some(gauge), form))
+    Ok((Some(shifted.0), form))
+}
+
+/// The measured gauge shifted by the model-form misfit of `fitted` (the base model with other
+/// values of the fitted parameters, e.g. a refit's), for a second look at a refit once the
+/// parameters have moved; `None` when it cannot be estimated.
+pub fn account_at(measured: &Gauge, fitted: &Setup) -> Result<Option<Gauge>> {
+    let Ok((setup, _)) = reference_setup(fitted) else { return Ok(None) };
+    let beam = Misfit::of(measured, fitted)?;
+    if !beam.failures.is_empty() {
+        return Ok(None);
+    }
+    Ok(shift(measured, &beam.r, &setup)?.ok().map(|s| s.0))
+}
+
+/// `gauge` with its data shifted by the smoothed difference between the residuals `r` of the
+/// base model and those of the `reference` setup, and that shift (noise units); or why not.
+fn shift(gauge: &Gauge, r: &[f64], reference: &Setup) -> Result<std::result::Result<(Gauge, Vec<f64>), String>> {
+    let misfit = Misfit::of(gauge, reference)?;
+    if !misfit.failures.is_empty() {
+        return Ok(Err(format!("the reference model stopped early: {}", misfit.failures.join("; "))));
+    }
+    let mut shifted = gauge.clone();
+    let mut all = Vec::with_capacity(gauge.len());
+    for (b, range) in shifted.blocks.iter_mut().zip(gauge.ranges()) {
+        // (test − reference)/σ − (test − base)/σ = (base − reference)/σ.
+        let raw: Vec<f64> = range.map(|i| misfit.r[i] - r[i]).collect();
+        let s = smooth(&b.x, &raw);
+        for (y, v) in b.y.iter_mut().zip(&s) {
+            *y += b.sigma * v;
+        }
+        all.extend(s);
+    }
+    Ok(Ok((shifted, all)))
 }
 
 #[cfg(test)]

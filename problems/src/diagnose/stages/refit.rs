@@ -200,5 +200,6 @@ pub fn report(base: &Base, regs: &[Regime], entry: &Ranked, out: &RefitOutcome) 
         delta_aic: aic - base_aic,
         delta_bic: bic - base_bic,
         evaluations: out.evaluations,
+        chi2_reestimated: None,
     }
 }

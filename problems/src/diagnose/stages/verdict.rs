@@ -109,7 +109,7 @@ pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusab
                 shrinkage: Some(r.shrinkage),
                 transfer_shrinkage: c.transfer.iter().find_map(|t| t.shrinkage),
                 confusable_with,
-                more_missing: chi2_survival(r.chi2, refit_dof(n, c)) <= NOISE_LEVEL,
+                more_missing: chi2_survival(r.chi2_reestimated.unwrap_or(r.chi2), refit_dof(n, c)) <= NOISE_LEVEL,
                 provisional,
                 reasons,
             }
@@ -278,6 +278,7 @@ mod tests {
                 delta_aic: delta_bic,
                 delta_bic,
                 evaluations: 0,
+                chi2_reestimated: None,
             }),
             transfer: transfer
                 .map(|s| Transfer {
