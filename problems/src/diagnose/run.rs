@@ -394,31 +394,9 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     // How far, and transfer.
     let holdout = Holdout::prepare(&base, &regs, &lin, opts.holdout, &say)?;
     let withheld = Withheld::prepare(&base, &opts.withheld, opts.noise)?;
-    let mut refits = BTreeMap::new();
     let above_noise = base.p_noise <= NOISE_LEVEL;
-    for i in ranking.to_refit(opts.refit, above_noise, &opts.always_refit) {
-        let entry = &mut ranking.ranked[i];
-        let c = entry.effect.clone();
-        say(&format!("refitting with {}", c.name()));
-        let (sens, score) = (entry.sensitivity.as_ref().expect("scored"), entry.result.score.as_ref().expect("scored"));
-        let out = match refit::refit(&base, &lin, c.as_ref(), sens, score) {
-            Ok(o) => o,
-            Err(e) => {
-                entry.result.error = Some(format!("refit failed: {e}"));
-                continue;
-            }
-        };
-        let report = refit::report(&base, &regs, entry, &out);
-        let params: Vec<Parameter> = sens.parameters.iter().map(|q| q.parameter.clone()).collect();
-        if let Some(h) = &holdout {
-            entry.result.transfer.push(h.check(&base, c.as_ref(), &params, &out, report.shrinkage, &say));
-        }
-        let effect: Vec<f64> = report.effect.iter().map(|v| v.value).collect();
-        let x: Vec<f64> = report.parameters.iter().map(|v| v.value).collect();
-        entry.result.transfer.extend(withheld.iter().map(|w| w.predict(c.as_ref(), &x, &effect)));
-        entry.result.refit = Some(report);
-        refits.insert(c.name().to_string(), (c.clone(), params, out));
-    }
+    let todo = ranking.to_refit(opts.refit, above_noise, &opts.always_refit);
+    let mut refits = refit_candidates(&base, &lin, &regs, &mut ranking, &todo, (holdout.as_ref(), &withheld), &say);
     let ranking::Ranking { ranked, skipped, pairs, confusable } = ranking;
     let mut candidates: Vec<CandidateResult> = ranked.into_iter().map(|r| r.result).collect();
     let base_fit = BaseFit {
@@ -496,4 +474,63 @@ fn reestimated(
     let fitted = base.space.apply(&base.setup, &base.space.from_unit(&out.v[..p]))?;
     let Some(gauge) = model_form::account_at(measured, &fitted)? else { return Ok(None) };
     Ok(refit::refit_on(&gauge, base, c, params, &out.v, out.jacobian.clone()).ok().map(|o| o.misfit.rss()))
+}
+
+/// A refitted candidate: the effect, its parameters and the refit.
+type Refitted = (std::sync::Arc<dyn crate::diagnose::CandidateEffect>, Vec<Parameter>, refit::RefitOutcome);
+/// A candidate's refit report, its transfer checks and the refit.
+type RefitDone = (Refit, Vec<Transfer>, Refitted);
+
+/// Refits the candidates `todo` of `ranking` side by side (each refit runs one simulation per
+/// step, so one refit alone leaves cores idle), checks their transfer, and writes the results
+/// into the ranking; returns the refits by candidate name. The results do not depend on the
+/// order the refits finish in.
+fn refit_candidates(
+    base: &base::Base,
+    lin: &crate::diagnose::score::Linearisation,
+    regs: &[Regime],
+    ranking: &mut ranking::Ranking,
+    todo: &[usize],
+    (holdout, withheld): (Option<&Holdout>, &[Withheld]),
+    say: &(dyn Fn(&str) + Sync),
+) -> BTreeMap<String, Refitted> {
+    use rayon::prelude::*;
+    let ranked = &ranking.ranked;
+    let done: Vec<(usize, std::result::Result<RefitDone, String>)> = todo
+        .par_iter()
+        .map(|&i| {
+            let entry = &ranked[i];
+            let c = entry.effect.clone();
+            say(&format!("refitting with {}", c.name()));
+            let (sens, score) =
+                (entry.sensitivity.as_ref().expect("scored"), entry.result.score.as_ref().expect("scored"));
+            let out = match refit::refit(base, lin, c.as_ref(), sens, score) {
+                Ok(o) => o,
+                Err(e) => return (i, Err(format!("refit failed: {e}"))),
+            };
+            let report = refit::report(base, regs, entry, &out);
+            let params: Vec<Parameter> = sens.parameters.iter().map(|q| q.parameter.clone()).collect();
+            let mut transfer = Vec::new();
+            if let Some(h) = holdout {
+                transfer.push(h.check(base, c.as_ref(), &params, &out, report.shrinkage, say));
+            }
+            let effect: Vec<f64> = report.effect.iter().map(|v| v.value).collect();
+            let x: Vec<f64> = report.parameters.iter().map(|v| v.value).collect();
+            transfer.extend(withheld.iter().map(|w| w.predict(c.as_ref(), &x, &effect)));
+            (i, Ok((report, transfer, (c, params, out))))
+        })
+        .collect();
+    let mut refits = BTreeMap::new();
+    for (i, d) in done {
+        let entry = &mut ranking.ranked[i];
+        match d {
+            Ok((report, transfer, refitted)) => {
+                entry.result.refit = Some(report);
+                entry.result.transfer.extend(transfer);
+                refits.insert(entry.result.name.clone(), refitted);
+            }
+            Err(e) => entry.result.error = Some(e),
+        }
+    }
+    refits
 }

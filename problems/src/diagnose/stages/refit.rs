@@ -143,20 +143,25 @@ pub fn refit(
     // tail's strength against its length): the refit is repeated from other values of every
     // parameter but the first, and the best kept.
     if !c.discrete() && params.len() > 1 {
-        for j in 1..params.len() {
-            for w in SECONDARY_STARTS {
-                if (out.v[p + j] - w).abs() < 0.1 {
-                    continue;
-                }
+        use rayon::prelude::*;
+        let starts: Vec<Vec<f64>> = (1..params.len())
+            .flat_map(|j| SECONDARY_STARTS.into_iter().map(move |w| (j, w)))
+            .filter(|&(j, w)| (out.v[p + j] - w).abs() >= 0.1)
+            .map(|(j, w)| {
                 let mut v = out.v.clone();
                 v[p + j] = w;
-                if let Ok(o) = refit_on(&base.gauge, base, c, &params, &v, out.jacobian.clone()) {
-                    if o.misfit.rss() < out.misfit.rss() {
-                        out = RefitOutcome { evaluations: out.evaluations + o.evaluations, ..o };
-                    } else {
-                        out.evaluations += o.evaluations;
-                    }
-                }
+                v
+            })
+            .collect();
+        // Side by side (a refit runs one simulation per step); the best kept, the first of equals.
+        let again: Vec<Result<RefitOutcome>> =
+            starts.par_iter().map(|v| refit_on(&base.gauge, base, c, &params, v, out.jacobian.clone())).collect();
+        for o in again.into_iter().flatten() {
+            let spent = out.evaluations + o.evaluations;
+            if o.misfit.rss() < out.misfit.rss() {
+                out = RefitOutcome { evaluations: spent, ..o };
+            } else {
+                out.evaluations = spent;
             }
         }
     }
