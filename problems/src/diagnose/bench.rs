@@ -99,6 +99,12 @@ pub struct CaseResult {
     pub base_fit: Vec<f64>,
     /// χ²/dof of the base fit.
     pub base_reduced_chi2: f64,
+    /// RMS of the model-form shift accounted for (noise units; 0 when it was not).
+    #[serde(default)]
+    pub model_form_shift_rms: f64,
+    /// χ²/dof of the base fit on the data as measured (before the model form was accounted for).
+    #[serde(default)]
+    pub base_reduced_chi2_as_measured: f64,
     /// Whether the base fit is at the noise level (the planted effect is then undetectable).
     pub base_at_noise_level: bool,
     /// χ²/dof with the true effect refitted.
@@ -187,6 +193,8 @@ fn case(
         ranking: Vec::new(),
         base_fit: Vec::new(),
         base_reduced_chi2: f64::NAN,
+        model_form_shift_rms: 0.0,
+        base_reduced_chi2_as_measured: f64::NAN,
         base_at_noise_level: false,
         true_reduced_chi2: None,
         true_at_noise_level: None,
@@ -303,6 +311,9 @@ fn with_gain(e: Experiment, g: f64) -> Result<Experiment> {
 /// effect's refit, failures and the candidates' angles.
 fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
     out.base_reduced_chi2 = d.base.reduced_chi2;
+    out.model_form_shift_rms = d.model_form.shift_rms;
+    out.base_reduced_chi2_as_measured =
+        d.base.reduced_chi2 * d.model_form.chi2_as_measured / d.base.chi2.max(f64::MIN_POSITIVE);
     out.base_fit = d.base.parameters.iter().map(|q| q.value).collect();
     out.base_at_noise_level = d.base.at_noise_level;
     out.ranking = d
