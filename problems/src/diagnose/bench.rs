@@ -560,8 +560,12 @@ fn summarise(effects: Vec<String>, cases: Vec<CaseResult>, wall_seconds: f64) ->
     }
     let mean_cos: Vec<(String, String, f64)> = sums.into_iter().map(|((a, b), (s, n))| (a, b, s / n as f64)).collect();
     let confusable: Vec<(String, String, f64)> = mean_cos.iter().filter(|p| p.2 > CONFUSABLE).cloned().collect();
-    let separable: Vec<String> =
-        effects.iter().filter(|e| !confusable.iter().any(|p| &p.0 == *e || &p.1 == *e)).cloned().collect();
+    // The out-of-library effect has no sensitivity, so no angle: it is no separable effect.
+    let separable: Vec<String> = effects
+        .iter()
+        .filter(|e| *e != GAIN && !confusable.iter().any(|p| &p.0 == *e || &p.1 == *e))
+        .cloned()
+        .collect();
     let sep_cases: Vec<&CaseResult> = cases.iter().filter(|c| separable.contains(&c.planted)).collect();
     let top1_separable = sep_cases.iter().filter(|c| right(c)).count() as f64 / sep_cases.len().max(1) as f64;
     let planted: Vec<&CaseResult> = cases.iter().filter(|c| c.planted != NONE && c.planted != GAIN).collect();
