@@ -266,29 +266,52 @@ impl RowScale {
     }
 }
 
-/// Converts engine rows to a record.
-pub fn to_record(rows: &[StepRow], s: &RowScale) -> Record {
+/// One converged state of a test engine (beam or continuum), as the record needs it.
+#[derive(Clone, Copy, Debug)]
+pub struct EngineState {
+    /// Control value.
+    pub control: f64,
+    /// Its reaction.
+    pub reaction: f64,
+    /// Debonded length, process-zone length and crack tip (mm).
+    pub crack: [f64; 3],
+    /// External work, elastic and dissipated energy of the simulated part (N·mm).
+    pub energies: [f64; 3],
+}
+
+impl From<&StepRow> for EngineState {
+    fn from(r: &StepRow) -> Self {
+        EngineState {
+            control: r.control,
+            reaction: r.reaction,
+            crack: [r.crack.debonded, r.crack.process_zone, r.crack.tip],
+            energies: [r.external_work, r.elastic_energy, r.dissipated_energy],
+        }
+    }
+}
+
+/// The record of engine states scaled into the specimen's displacement, load and energies, read
+/// through the instruments (every beam-test engine records this way).
+pub fn record_states(states: &[EngineState], s: &RowScale) -> Record {
     let mut rec = new_record();
-    let readings = s.readings(rows.iter().map(|r| (r.control, r.reaction)));
-    let unloaded = readings.len() > rows.len();
+    let readings = s.readings(states.iter().map(|r| (r.control, r.reaction)));
+    let unloaded = readings.len() > states.len();
     if unloaded {
         // The seating toe: the load stays at its zero until the offset is taken up.
-        let tip = rows.first().map_or(0.0, |r| r.crack.tip);
+        let tip = states.first().map_or(0.0, |r| r.crack[2]);
         rec.push(&[readings[0][0], readings[0][1], 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
     }
-    for (r, [delta, p]) in rows.iter().zip(&readings[usize::from(unloaded)..]) {
-        rec.push(&[
-            *delta,
-            *p,
-            r.crack.debonded,
-            r.crack.process_zone,
-            r.crack.tip,
-            s.energy * r.external_work,
-            s.energy * r.elastic_energy,
-            s.energy * r.dissipated_energy,
-        ]);
+    for (r, [delta, p]) in states.iter().zip(&readings[usize::from(unloaded)..]) {
+        let [debonded, zone, tip] = r.crack;
+        let [work, elastic, dissipated] = r.energies.map(|e| s.energy * e);
+        rec.push(&[*delta, *p, debonded, zone, tip, work, elastic, dissipated]);
     }
     rec
+}
+
+/// Converts engine rows to a record.
+pub fn to_record(rows: &[StepRow], s: &RowScale) -> Record {
+    record_states(&rows.iter().map(EngineState::from).collect::<Vec<_>>(), s)
 }
 
 /// Checks a length is positive.

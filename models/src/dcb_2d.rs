@@ -112,12 +112,7 @@ impl Dcb2d {
             return Err(CzError::invalid(FROM, "symmetry", f64::NAN, "only equal arms have a continuum counterpart"));
         }
         let fx = &beam.effects;
-        let mut material = beam.material.clone();
-        // Switched off, an effect leaves the material as it is, bit for bit.
-        if fx.root_compliance > 0.0 {
-            material.e22 = 1.0 / (1.0 / material.e22 + 2.0 * fx.root_compliance / beam.h);
-        }
-        material.g13 = fx.shear_modulus(material.g13);
+        let material = material_of_beam(&beam.material, fx, beam.h);
         Ok(Dcb2d {
             a0: beam.a0,
             length: beam.length,
@@ -304,4 +299,17 @@ impl ForwardModel for Dcb2d {
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
         self.simulate_with_stats(law).map(|(r, _)| r)
     }
+}
+
+/// The arms' material of the continuum counterpart of a beam model whose arms are `h` thick: the
+/// beam's extra compliances as the material change they stand for (`root_compliance c` lowers
+/// E22 so that `h/(2 E22)` grows by `c`; `shear_compliance s` lowers G13 to `1/(1/G13 + s)`).
+/// Switched off, an effect leaves the material as it is, bit for bit.
+pub(crate) fn material_of_beam(material: &Material, fx: &crate::effects::Effects, h: f64) -> Material {
+    let mut m = material.clone();
+    if fx.root_compliance > 0.0 {
+        m.e22 = 1.0 / (1.0 / m.e22 + 2.0 * fx.root_compliance / h);
+    }
+    m.g13 = fx.shear_modulus(m.g13);
+    m
 }

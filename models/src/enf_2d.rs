@@ -93,11 +93,7 @@ impl Enf2d {
     /// change they stand for). The mesh keeps the beam's interface element.
     pub fn from_beam(beam: &crate::enf::Enf) -> Result<Enf2d> {
         let fx = &beam.effects;
-        let mut material = beam.material.clone();
-        if fx.root_compliance > 0.0 {
-            material.e22 = 1.0 / (1.0 / material.e22 + 2.0 * fx.root_compliance / beam.h);
-        }
-        material.g13 = fx.shear_modulus(material.g13);
+        let material = crate::dcb_2d::material_of_beam(&beam.material, fx, beam.h);
         let m = Enf2d {
             a0: beam.a0,
             half_span: beam.half_span,

@@ -164,24 +164,14 @@ impl ContinuumEffects {
 
 /// The record of `rows` scaled into the specimen's displacement, load and energies.
 pub fn record(rows: &[Row], s: &RowScale) -> Record {
-    let mut rec = beamtest::new_record();
-    let readings = s.readings(rows.iter().map(|r| (r.control, r.reaction)));
-    let unloaded = readings.len() > rows.len();
-    if unloaded {
-        let tip = rows.first().map_or(0.0, |r| r.crack.tip);
-        rec.push(&[readings[0][0], readings[0][1], 0.0, 0.0, tip, 0.0, 0.0, 0.0]);
-    }
-    for (r, [delta, p]) in rows.iter().zip(&readings[usize::from(unloaded)..]) {
-        rec.push(&[
-            *delta,
-            *p,
-            r.crack.debonded,
-            r.crack.process_zone,
-            r.crack.tip,
-            s.energy * r.external_work,
-            s.energy * r.elastic_energy,
-            s.energy * r.dissipated_energy,
-        ]);
-    }
-    rec
+    let states: Vec<beamtest::EngineState> = rows
+        .iter()
+        .map(|r| beamtest::EngineState {
+            control: r.control,
+            reaction: r.reaction,
+            crack: [r.crack.debonded, r.crack.process_zone, r.crack.tip],
+            energies: [r.external_work, r.elastic_energy, r.dissipated_energy],
+        })
+        .collect();
+    beamtest::record_states(&states, s)
 }
