@@ -170,16 +170,39 @@ impl Dcb {
     /// shorter than the law's cohesive zone (or two interface elements): the specimen is then
     /// splitting and the steps after it (the arms springing back, openings falling below zero)
     /// describe no test. `Err` (with the record unchanged) when the crack never got there.
+    ///
+    /// The cohesive zone's length is an estimate; the arms springing back is the split itself: a
+    /// row whose stored elastic energy fell below 1 % of the largest so far, once the crack has
+    /// grown, ends the record before it.
     fn until_split(&self, mut record: Record, law: &dyn CohesiveLaw) -> std::result::Result<Record, Record> {
         let zone = self.cohesive_zone_length(law);
         let end = self.length - (2.0 * self.mesh.interface_element).max(if zone.is_finite() { zone } else { 0.0 });
-        let Some(split) =
-            record.column(czid_core::columns::CRACK_TIP).ok().and_then(|tip| tip.iter().position(|&t| t >= end))
-        else {
+        let by_length = record
+            .column(czid_core::columns::CRACK_TIP)
+            .ok()
+            .and_then(|tip| tip.iter().position(|&t| t >= end))
+            .map(|i| i + 1);
+        let by_springback = self.springback(&record);
+        let Some(keep) = by_length.into_iter().chain(by_springback).min() else {
             return Err(record);
         };
-        record.truncate(split + 1);
+        record.truncate(keep);
         Ok(record)
+    }
+
+    /// Rows before the first one where the arms have sprung back: the elastic energy below 1 % of
+    /// its largest value so far after the crack has grown.
+    fn springback(&self, record: &Record) -> Option<usize> {
+        let elastic = record.column(czid_core::columns::ELASTIC_ENERGY).ok()?;
+        let grown = record.column(czid_core::columns::DEBONDED_LENGTH).ok()?;
+        let mut most = 0.0f64;
+        for (i, (&u, &l)) in elastic.iter().zip(grown).enumerate() {
+            if l > 0.0 && u < 0.01 * most {
+                return Some(i);
+            }
+            most = most.max(u);
+        }
+        None
     }
 
     /// Crack length the mesh uses: `a0 + effects.crack_length_offset` (mm).

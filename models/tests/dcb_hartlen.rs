@@ -46,3 +46,23 @@ fn hartlen_dcb_reaches_30_mm_with_both_kinematics() {
     println!("large vs small rotations at 30 mm: load {:+.2} %", 100.0 * rel);
     assert!(rel.abs() > 1e-3 && rel.abs() < 0.2);
 }
+
+#[test]
+fn a_specimen_that_splits_before_the_zone_estimate_says_so_ends_at_the_split() {
+    // DCB-02 driven to the end of its test with a weak, tough normal branch (from a joint
+    // DCB + ENF fit): the arms spring back while the ligament ahead of the crack is still longer
+    // than the slender-arm estimate of the cohesive zone. The rows after the split (openings and
+    // loads falling to zero) describe no test and must not be recorded, nor the run fail there.
+    use czid_core::ForwardModel;
+    let mut d = Dcb::hartlen_dcb01();
+    d.a0 = 33.005;
+    d.material.e11 = 32_554.79;
+    d.control.max_displacement = Some(36.9);
+    let law = Bilinear::bk(1e5, 9.654621, 31.94808, 0.8162914, 3.485673, 2.0).unwrap();
+    let rec = d.simulate(&law).unwrap_or_else(|f| panic!("{}", f.error));
+    let (x, p) = (col(&rec, columns::DISPLACEMENT), col(&rec, columns::LOAD));
+    assert!(x.windows(2).all(|w| w[1] > w[0]), "the recorded opening must only grow");
+    assert!(p.iter().all(|v| *v >= 0.0), "a negative load was recorded");
+    let tip = *col(&rec, columns::CRACK_TIP).last().unwrap();
+    assert!(tip > 100.0 && tip < 123.0, "ends with the crack near the end: {tip}");
+}

@@ -353,6 +353,14 @@ impl<'a> WholeMesh<'a> {
                 c.overshoots += 1;
                 self.stats.cuts += 1;
             }
+            Ok(_) if !self.dissipates(lam, tau_try) => {
+                // The constraint measures released energy by the secant rule, exact for a
+                // linear-elastic unloading; a non-linear elastic response (contact on the cracked
+                // faces of an ENF) meets it on a branch that dissipates nothing, and unloading
+                // along it describes no test. Jump over the unstable stretch instead.
+                self.stats.cuts += 1;
+                return self.jump_over(c);
+            }
             Ok(it) => {
                 self.commit(lam, true);
                 self.stats.dissipation_steps += 1;
@@ -386,6 +394,33 @@ impl<'a> WholeMesh<'a> {
             }
         }
         Ok(())
+    }
+
+    /// Whether accepting the trial solution (with load `reaction`) would dissipate a fair share
+    /// (1 %) of the prescribed `tau`: the same ledger update as [`WholeMesh::commit`], on a copy.
+    fn dissipates(&self, reaction: f64, tau: f64) -> bool {
+        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let (t, g) = (&self.nw.asm.trial, &self.nw.asm.gaps);
+        let mut ledger = self.ledger.clone();
+        let dc = self.trial[ic] - self.cur.q[ic];
+        if self.segments {
+            ledger.commit_along(
+                &p.points,
+                law,
+                &self.cur.states,
+                t,
+                g,
+                dc,
+                self.cur.reaction,
+                reaction,
+                self.mode_one.as_ref(),
+            );
+        } else {
+            ledger.commit(&p.points, t, g, dc, self.cur.reaction, reaction);
+        }
+        let states: Vec<LawState> = t.iter().map(|ev| ev.state).collect();
+        let dissipated = ledger.interface_work - energy::interface_stored(&p.points, law, &states, t, g);
+        dissipated - self.last_diss > 0.01 * tau
     }
 
     /// Last resort when the dissipation constraint cannot be met: jump over the unstable stretch
