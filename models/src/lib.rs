@@ -10,6 +10,7 @@ pub mod dcb_2d;
 pub mod effects;
 pub mod enf;
 pub mod enf_2d;
+pub mod enf_reduction;
 pub mod fe;
 pub mod frp;
 pub mod laws;
