@@ -103,10 +103,16 @@ pub struct ExperimentSpec {
     /// when a channel drops out).
     #[serde(default)]
     pub drop_non_finite: bool,
+    /// Compensate a seating toe as ASTM D790, D5528 and D7905 do: fit a line to the rising branch
+    /// where the load lies between these fractions of the peak load (e.g. `[0.2, 0.5]`), move the
+    /// displacement zero to where that line meets zero load, and drop the readings before the
+    /// branch (the toe, where the fixture seats). The shift is reported with the dropped rows.
+    #[serde(default)]
+    pub toe_compensation: Option<[f64; 2]>,
 }
 
 /// Rows of a data file that reading left out, by reason.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct DroppedRows {
     /// With a missing or non-finite reading (`drop_non_finite`).
     pub non_finite: usize,
@@ -114,20 +120,29 @@ pub struct DroppedRows {
     pub non_increasing: usize,
     /// Outside the displacement `range`.
     pub out_of_range: usize,
+    /// Before the linear branch of a compensated seating toe (`toe_compensation`).
+    pub toe: usize,
+    /// Where the compensated toe's linear branch meets zero load (mm, in the file's zero): every
+    /// kept displacement was moved down by it. Zero without `toe_compensation`.
+    pub toe_zero: f64,
 }
 
 impl DroppedRows {
     /// What was dropped, in words (`None`: nothing).
     pub fn describe(&self) -> Option<String> {
-        let parts: Vec<String> = [
+        let mut parts: Vec<String> = [
             (self.non_finite, "with a missing or non-finite reading"),
             (self.non_increasing, "whose displacement does not increase"),
             (self.out_of_range, "outside the displacement range"),
+            (self.toe, "in the seating toe"),
         ]
         .iter()
         .filter(|(n, _)| *n > 0)
         .map(|(n, why)| format!("{n} {why}"))
         .collect();
+        if self.toe_zero != 0.0 {
+            parts.push(format!("displacement zero moved by {:.4} mm (toe compensation)", self.toe_zero));
+        }
         (!parts.is_empty()).then(|| format!("rows dropped: {}", parts.join(", ")))
     }
 }
@@ -259,6 +274,11 @@ impl ExperimentSpec {
                 ));
             }
         }
+        if let Some(band) = self.toe_compensation {
+            let (toe, zero) = compensate_toe(&mut monotone, band, &shown)?;
+            dropped.toe = toe;
+            dropped.toe_zero = zero;
+        }
         // One reading is no curve: nothing could be fitted to it, and every parameter would look
         // determined by it.
         if monotone.len() < 2 {
@@ -288,6 +308,55 @@ impl ExperimentSpec {
         let name = self.file.file_stem().map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
         Ok(Experiment { name, load, debonded_length, initial_crack, dropped })
     }
+}
+
+/// Toe compensation (ASTM D790, D5528, D7905): the line through the rising branch with loads in
+/// `band` × the peak load, `P = k (δ − δ₀)`, moves the displacement zero to `δ₀`; the readings
+/// before the branch, and any left at a negative displacement, are dropped. Returns the number of
+/// rows dropped and `δ₀` (mm).
+fn compensate_toe(rows: &mut Vec<Row>, [lo, hi]: [f64; 2], shown: &str) -> Result<(usize, f64)> {
+    if !(lo > 0.0 && lo < hi && hi < 1.0) {
+        return Err(CzError::config(
+            format!("experiment `{shown}`, `toe_compensation`"),
+            format!("[{lo}, {hi}] must be fractions of the peak load with 0 < min < max < 1, e.g. [0.2, 0.5]"),
+        ));
+    }
+    if rows.is_empty() {
+        return Err(CzError::data(shown, "toe compensation: no readings left"));
+    }
+    let peak_at = rows.iter().enumerate().fold(0, |m, (i, r)| if r.y > rows[m].y { i } else { m });
+    let peak = rows[peak_at].y;
+    let band: Vec<&Row> = rows[..=peak_at].iter().filter(|r| r.y >= lo * peak && r.y <= hi * peak).collect();
+    let fail = |why: String| {
+        CzError::data(
+            shown,
+            format!("toe compensation: {why}; choose `toe_compensation` around the straight part of the rising curve"),
+        )
+    };
+    if band.len() < 3 {
+        return Err(fail(format!(
+            "{} reading(s) with loads between {lo} and {hi} × the peak load {peak} N before the peak, 3 are needed",
+            band.len()
+        )));
+    }
+    // Least squares of P on δ over the band.
+    let n = band.len() as f64;
+    let (mx, my) = (band.iter().map(|r| r.x).sum::<f64>() / n, band.iter().map(|r| r.y).sum::<f64>() / n);
+    let sxy: f64 = band.iter().map(|r| (r.x - mx) * (r.y - my)).sum();
+    let sxx: f64 = band.iter().map(|r| (r.x - mx).powi(2)).sum();
+    let slope = sxy / sxx;
+    if !(slope > 0.0 && slope.is_finite()) {
+        return Err(fail(format!("the readings in the band do not rise (slope {slope} N/mm)")));
+    }
+    let zero = mx - my / slope;
+    let first = rows.iter().position(|r| r.y >= lo * peak).unwrap_or(0);
+    let before = rows.len();
+    rows.drain(..first);
+    rows.retain(|r| r.x - zero >= 0.0);
+    for r in rows.iter_mut() {
+        r.x -= zero;
+    }
+    Ok((before - rows.len(), zero))
 }
 
 /// Whether a used cell of `record` is empty or reads as a non-finite number (`NaN`, `inf`).
@@ -322,6 +391,7 @@ mod tests {
             range: None,
             drop_non_increasing: false,
             drop_non_finite: false,
+            toe_compensation: None,
         }
     }
 
@@ -397,6 +467,33 @@ mod tests {
         // A text cell is still an error: it is not a gap in the record but a wrong column.
         let dir = write("text-row", "Disp,Force,CrackExt\n0,0,1\n1,abc,1\n2,2,1\n");
         assert!(s.load(&dir).unwrap_err().to_string().contains("`abc` is not a number"));
+    }
+
+    #[test]
+    fn a_seating_toe_is_compensated_by_the_line_through_the_rising_branch() {
+        // A toe up to δ = 1 mm, then the straight branch P = 100 (δ − 0.5) to the peak at 3 mm,
+        // then a drop: the zero moves to 0.5 mm and the toe's readings are dropped.
+        let text = "Disp,Force,CrackExt\n0,0,1\n0.5,1,1\n0.8,20,1\n1.0,50,1\n1.5,100,1\n2.0,150,1\n\
+                    2.5,200,1\n3.0,250,1\n3.5,120,1\n";
+        let dir = write("toe", text);
+        let mut s = spec("t.csv");
+        s.toe_compensation = Some([0.15, 0.9]);
+        let e = s.load(&dir).unwrap();
+        assert!((e.dropped.toe_zero - 0.5).abs() < 1e-12, "{:?}", e.dropped);
+        // 0, 0.5 (1 N) and 0.8 (20 N) lie below 0.15 × 250 N.
+        assert_eq!(e.dropped.toe, 3);
+        assert_eq!(e.load.x()[0], 0.5);
+        assert_eq!(e.load.y()[0], 50.0);
+        assert_eq!(*e.load.x().last().unwrap(), 3.0);
+        let said = e.dropped.describe().unwrap();
+        assert!(said.contains("3 in the seating toe") && said.contains("moved by 0.5000 mm"), "{said}");
+
+        s.toe_compensation = Some([0.5, 0.2]);
+        let err = s.load(&dir).unwrap_err().to_string();
+        assert!(err.contains("toe_compensation") && err.contains("0 < min < max < 1"), "{err}");
+        s.toe_compensation = Some([0.97, 0.99]);
+        let err = s.load(&dir).unwrap_err().to_string();
+        assert!(err.contains("3 are needed") && err.contains("t.csv"), "{err}");
     }
 
     #[test]

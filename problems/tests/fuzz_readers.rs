@@ -348,6 +348,11 @@ fn csv_data_never_panics_and_what_is_accepted_is_sound() {
             range,
             drop_non_increasing: rng.random(),
             drop_non_finite: rng.random(),
+            toe_compensation: match rng.random_range(0..4) {
+                0 => Some([rng.random_range(-0.2..0.6), rng.random_range(0.1..1.2)]),
+                1 => Some([f64::NAN, 0.5]),
+                _ => None,
+            },
         };
         match spec.load(&dir) {
             Ok(e) => {
