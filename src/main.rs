@@ -62,10 +62,27 @@ enum Command {
         /// Continue an interrupted run from the checkpoint in the output folder.
         #[arg(long)]
         resume: bool,
+        /// Leave these experiments out (comma separated names), to predict them afterwards with
+        /// `czid predict`.
+        #[arg(long, value_delimiter = ',')]
+        leave_out: Vec<String>,
         /// Abort the process once this many evaluations are done, as a kill would (for tests of
         /// interruption and resume).
         #[arg(long, hide = true)]
         abort_after_evaluations: Option<usize>,
+    },
+    /// Run every experiment of a problem file at the values a calibration identified and report
+    /// how far each test lies from its prediction (prediction.json, fits and plots).
+    Predict {
+        /// Problem file (TOML).
+        problem: PathBuf,
+        /// The calibration's result.json (from `czid identify`, e.g. with `--leave-out`).
+        #[arg(long)]
+        from: PathBuf,
+        #[command(flatten)]
+        out: OutArgs,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Make a synthetic test (CSV) from a truth file: a law, a model and a noise description.
     Synthesize {
@@ -134,8 +151,9 @@ struct OutArgs {
 
 /// A rank other than 0: builds the same problem as rank 0 (only rank 0 writes anything) and
 /// evaluates what it sends.
-fn serve(cluster: &Cluster, problem: &Path, sets: &[(String, String)]) -> ExitCode {
-    match LoadedProblem::read_with(problem, sets).and_then(|p| p.identification()).and_then(|id| cluster.serve(&id)) {
+fn serve(cluster: &Cluster, problem: &Path, sets: &[(String, String)], leave_out: &[String]) -> ExitCode {
+    let problem = LoadedProblem::read_with(problem, sets).and_then(|mut p| p.leave_out(leave_out).map(|()| p));
+    match problem.and_then(|p| p.identification()).and_then(|id| cluster.serve(&id)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => fail(&e),
     }
@@ -151,10 +169,21 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Demo { out } => demo(&out),
         Command::Simulate { problem, out, set } => run_simulate(&problem, &set.sets, &out),
-        Command::Identify { problem, out, set, optimizer, seed, budget, resume, abort_after_evaluations } => {
+        Command::Predict { problem, from, out, set } => run_predict(&problem, &from, &set.sets, &out),
+        Command::Identify {
+            problem,
+            out,
+            set,
+            optimizer,
+            seed,
+            budget,
+            resume,
+            leave_out,
+            abort_after_evaluations,
+        } => {
             let cluster = Cluster::join();
             if cluster.is_worker() {
-                return serve(&cluster, &problem, &set.sets);
+                return serve(&cluster, &problem, &set.sets, &leave_out);
             }
             let opts = RunOptions {
                 optimizer,
@@ -166,7 +195,7 @@ fn main() -> ExitCode {
                 abort_after: abort_after_evaluations,
                 spread: cluster.spread(),
             };
-            let outcome = run_identify(&problem, &set.sets, &out, &opts);
+            let outcome = run_identify(&problem, &set.sets, &leave_out, &out, &opts);
             cluster.finish("evaluations");
             outcome
         }
@@ -184,7 +213,7 @@ fn main() -> ExitCode {
         Command::Compare { problem, optimizers, seeds, budget, target, out, set } => {
             let cluster = Cluster::join();
             if cluster.is_worker() {
-                return serve(&cluster, &problem, &set.sets);
+                return serve(&cluster, &problem, &set.sets, &[]);
             }
             let opts = CompareOptions { optimizers, seeds, budget, target, spread: cluster.spread() };
             let outcome = run_compare(&problem, &set.sets, &out, &opts);
@@ -271,8 +300,15 @@ fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Res
     }
 }
 
-fn run_identify(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &RunOptions) -> Result<(), CzError> {
-    let problem = read_problem(problem, sets)?;
+fn run_identify(
+    problem: &Path,
+    sets: &[(String, String)],
+    leave_out: &[String],
+    out: &OutArgs,
+    opts: &RunOptions,
+) -> Result<(), CzError> {
+    let mut problem = read_problem(problem, sets)?;
+    problem.leave_out(leave_out)?;
     let dir = OutputDir::create(&out.out, out.force, opts.resume)?;
     let res = identify(&problem, opts, &dir)?;
     if res.resumed > 0 {
@@ -285,10 +321,38 @@ fn run_identify(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: 
     for (path, p) in &res.parameters {
         println!("  {path:<28} = {:>12.6e} {:<8} {}", p.value, p.unit, p.verdict);
     }
+    for (term, e) in &res.rms_error {
+        println!(
+            "  rms error {term:<18} = {:>10.4} {:<3} ({:.2} % of the test's peak)",
+            e.value, e.unit, e.percent_of_peak
+        );
+    }
     for w in &res.warnings {
         println!("warning: {w}");
     }
     println!("results, fits and plots in {}", dir.path().display());
+    Ok(())
+}
+
+fn run_predict(problem: &Path, from: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
+    let problem = read_problem(problem, sets)?;
+    let dir = OutputDir::create(&out.out, out.force, false)?;
+    let p = czid_problems::predict::predict(&problem, from, &dir)?;
+    for (path, v) in &p.parameters {
+        println!("  {path:<28} = {v:>12.6e}");
+    }
+    println!("  {:<24} {:>12} {:>18}  role", "term", "rms error", "% of the test's peak");
+    for t in &p.terms {
+        let role = if t.calibrated { "calibrated" } else { "held out" };
+        println!(
+            "  {:<24} {:>9.4} {:<3}{:>17.2} %  {role}",
+            t.term, t.error.value, t.error.unit, t.error.percent_of_peak
+        );
+    }
+    for f in &p.failures {
+        println!("warning: a run failed part way: {f}");
+    }
+    println!("prediction, fits and plots in {}", dir.path().display());
     Ok(())
 }
 
@@ -366,6 +430,7 @@ fn demo(out: &Path) -> Result<(), CzError> {
     );
     run_identify(
         &problem,
+        &[],
         &[],
         &OutArgs { out: out.to_path_buf(), force: true },
         &RunOptions {

@@ -49,6 +49,17 @@ pub enum Term {
     DebondedLength,
 }
 
+/// A term's root-mean-square error at the identified parameters ([`Identification::term_errors`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RmsError {
+    /// Root-mean-square of test minus model over the test's readings.
+    pub value: f64,
+    /// Its unit (`N` or `mm`).
+    pub unit: String,
+    /// In % of the largest reading of the test's curve.
+    pub percent_of_peak: f64,
+}
+
 impl Term {
     /// Short name used in reports: `F` or `L`, as in the paper.
     pub fn symbol(self) -> &'static str {
@@ -313,6 +324,29 @@ impl Identification {
         for fit in &self.fits {
             let v = fit.objective.evaluate(&outcome.records[&fit.name])?;
             out.extend(fit.objective.terms().iter().zip(v.terms).map(|(t, s)| (t.name.clone(), s)));
+        }
+        Ok(out)
+    }
+
+    /// Root-mean-square error of each experiment's terms in the data's own unit (N for the load,
+    /// mm for the debonded length) and in % of the data's peak: the misfit as a test engineer
+    /// reads it. From `||φ||² = Σ(y − ŷ)² / Σy²`, `rms = √(||φ||² Σy² / n)`.
+    pub fn term_errors(&self, outcome: &Outcome) -> Result<Vec<(String, RmsError)>> {
+        let mut out = Vec::new();
+        for fit in &self.fits {
+            let v = fit.objective.evaluate(&outcome.records[&fit.name])?;
+            for ((term, kind), misfit) in fit.objective.terms().iter().zip(&fit.kinds).zip(v.terms) {
+                let y = term.data.y();
+                let mean_square = y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64;
+                let peak = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let value = (misfit * mean_square).sqrt();
+                let unit = match kind {
+                    Term::Load => "N",
+                    Term::DebondedLength => "mm",
+                };
+                let percent_of_peak = if peak > 0.0 { 100.0 * value / peak } else { f64::NAN };
+                out.push((term.name.clone(), RmsError { value, unit: unit.to_string(), percent_of_peak }));
+            }
         }
         Ok(out)
     }

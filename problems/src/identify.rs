@@ -94,6 +94,8 @@ pub struct IdentifyResult {
     pub misfit: BTreeMap<String, f64>,
     /// Weights α per experiment and term.
     pub weights: BTreeMap<String, f64>,
+    /// Root-mean-square error per experiment and term, in the data's unit and in % of its peak.
+    pub rms_error: BTreeMap<String, crate::identification::RmsError>,
     /// Objective evaluations spent.
     pub evaluations: usize,
     /// Evaluations whose simulation failed.
@@ -417,6 +419,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         objective_terms,
         misfit: id.term_values(&outcome)?.into_iter().collect(),
         weights: id.weights().into_iter().collect(),
+        rms_error: id.term_errors(&outcome)?.into_iter().collect(),
         evaluations: result.evaluations,
         failed_evaluations: result.failures,
         wall_seconds: wall,
@@ -511,7 +514,7 @@ pub fn simulate(problem: &LoadedProblem, out: &OutputDir) -> Result<Outcome> {
     Ok(outcome)
 }
 
-fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &OutputDir, stem: &str) -> Result<()> {
+pub(crate) fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &OutputDir, stem: &str) -> Result<()> {
     let several = outcome.records.len() > 1;
     for e in &problem.experiments {
         let record = &outcome.records[&e.name];

@@ -22,6 +22,7 @@ pub mod identifiability;
 pub mod identification;
 pub mod identify;
 pub mod output;
+pub mod predict;
 pub use czid_optimizers::plot;
 pub mod problem_file;
 pub mod resume;

@@ -296,6 +296,28 @@ impl LoadedProblem {
         Ok(LoadedProblem { path: path.to_path_buf(), file, experiments, mesh_notes })
     }
 
+    /// Leaves the named experiments out (their data and models), e.g. to calibrate on the others
+    /// and predict these with [`crate::predict`]. Unknown names, or leaving nothing, are errors.
+    pub fn leave_out(&mut self, names: &[String]) -> Result<()> {
+        let shown = self.path.display().to_string();
+        let have: Vec<String> = self.experiments.iter().map(|e| e.name.clone()).collect();
+        if let Some(unknown) = names.iter().find(|n| !have.contains(n)) {
+            return Err(CzError::config(
+                format!("{shown}, --leave-out"),
+                format!("no experiment is named `{unknown}`; the experiments are: {}", have.join(", ")),
+            ));
+        }
+        if have.iter().all(|n| names.contains(n)) {
+            return Err(CzError::config(format!("{shown}, --leave-out"), "every experiment would be left out"));
+        }
+        let keep: Vec<bool> = have.iter().map(|n| !names.contains(n)).collect();
+        let mut flags = keep.iter();
+        self.file.experiment.retain(|_| *flags.next().expect("one flag per experiment"));
+        let mut flags = keep.iter();
+        self.experiments.retain(|_| *flags.next().expect("one flag per experiment"));
+        Ok(())
+    }
+
     /// What reading the data left out, one line per experiment that lost rows (e.g.
     /// `dcb01: rows dropped: 12 whose displacement does not increase`), for the user to see.
     pub fn reading_notes(&self) -> Vec<String> {

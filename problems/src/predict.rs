@@ -1,0 +1,90 @@
+//! Prediction of tests at identified parameters: the law (and moduli) calibrated on some
+//! specimens, run on others, and how far each test lies from its prediction.
+//!
+//! `czid identify file.toml --leave-out enf03` calibrates on the other specimens; `czid predict
+//! file.toml --from out/result.json` then runs every specimen of the file at the identified
+//! values and reports each one's root-mean-square error, marked calibrated or held out (held out:
+//! absent from the calibration's result). A law that describes the material predicts a held-out
+//! specimen about as well as it fits the calibration specimens.
+
+use czid_core::{CzError, Result};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::identification::RmsError;
+use crate::identify::write_fits;
+use crate::output::OutputDir;
+use crate::problem_file::LoadedProblem;
+
+/// One experiment's term, predicted.
+#[derive(Clone, Debug, Serialize)]
+pub struct PredictedTerm {
+    /// Term name, e.g. `F:enf03`.
+    pub term: String,
+    /// Whether the calibration fitted this experiment (else it was held out).
+    pub calibrated: bool,
+    /// Its error at the identified values.
+    pub error: RmsError,
+}
+
+/// `prediction.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Prediction {
+    /// The problem file.
+    pub problem: String,
+    /// The calibration's `result.json`.
+    pub from: String,
+    /// The values used, by parameter path.
+    pub parameters: BTreeMap<String, f64>,
+    /// Every experiment's terms.
+    pub terms: Vec<PredictedTerm>,
+    /// Runs that failed part way (their last state is held).
+    pub failures: Vec<String>,
+}
+
+/// Runs every experiment of `problem` at the parameters of the calibration result `from` (a
+/// `result.json` of `czid identify`), writes `prediction.json` and the fits (`predict-*.csv`,
+/// plots) to `out`.
+pub fn predict(problem: &LoadedProblem, from: &Path, out: &OutputDir) -> Result<Prediction> {
+    let shown = from.display().to_string();
+    let text =
+        std::fs::read_to_string(from).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
+    let result: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| CzError::config(&shown, format!("not a result.json: {e}")))?;
+    let id = problem.identification()?;
+    let mut x = Vec::new();
+    let mut parameters = BTreeMap::new();
+    for p in id.space().parameters() {
+        let v = result["parameters"][&p.path]["value"].as_f64().ok_or_else(|| {
+            CzError::config(
+                &shown,
+                format!("holds no value for the parameter `{}` of {}", p.path, problem.path.display()),
+            )
+        })?;
+        x.push(v);
+        parameters.insert(p.path.clone(), v);
+    }
+    let calibrated: Vec<String> = result["rms_error"]
+        .as_object()
+        .or_else(|| result["misfit"].as_object())
+        .map(|m| m.keys().cloned().collect())
+        .unwrap_or_default();
+    let outcome = id.simulate(&x)?;
+    let terms = id
+        .term_errors(&outcome)?
+        .into_iter()
+        .map(|(term, error)| PredictedTerm { calibrated: calibrated.contains(&term), term, error })
+        .collect();
+    let prediction = Prediction {
+        problem: problem.path.display().to_string(),
+        from: shown,
+        parameters,
+        terms,
+        failures: outcome.failures.clone(),
+    };
+    let json = serde_json::to_string_pretty(&prediction).map_err(|e| CzError::config("prediction", e.to_string()))?;
+    out.write("prediction.json", &json)?;
+    write_fits(problem, &outcome, out, "predict")?;
+    Ok(prediction)
+}
