@@ -27,6 +27,12 @@ fn every_bundled_problem_file_loads() {
         "examples/hartlen-dcb/dcb02.toml",
         "examples/hartlen-dcb/dcb03.toml",
         "examples/hartlen-dcb/joint.toml",
+        "examples/hartlen-enf/enf03.toml",
+        "examples/hartlen-enf/enf04.toml",
+        "examples/hartlen-enf/enf05.toml",
+        "examples/hartlen-enf/joint.toml",
+        "examples/hartlen-enf/enf04-toe-model.toml",
+        "examples/hartlen-joint/dcb-enf.toml",
         "examples/frp-pull/problem.toml",
     ] {
         let p = czid_problems::problem_file::LoadedProblem::read(&root.join(file))
