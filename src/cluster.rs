@@ -1,10 +1,13 @@
-//! Several MPI ranks running one identification (`--features mpi`, `mpiexec -n N czid identify
-//! ...`): rank 0 runs the command as usual and spreads its batches of evaluations over every
-//! rank; the other ranks read the same problem file, build the same problem and evaluate what
-//! rank 0 sends until it is done. Without the feature, or on one rank, nothing changes.
+//! Several MPI ranks running one command (`--features mpi`, `mpiexec -n N czid identify ...`):
+//! rank 0 runs the command as usual and spreads its batches of evaluations (identify, compare) or
+//! its tasks (gap-bench's cases, a diagnosis's refits) over every rank; the other ranks read the
+//! same input, build the same problem, plan or diagnosis and do what rank 0 sends until it is
+//! done. Without the feature, or on one rank, nothing changes.
 
 use czid_core::{CzError, Problem};
+use czid_problems::farm::TaskFarm;
 use czid_problems::identify::Spread;
+use std::sync::Arc;
 
 /// This process's place among the ranks.
 pub struct Cluster {
@@ -15,6 +18,9 @@ pub struct Cluster {
     rank: usize,
     #[cfg(feature = "mpi")]
     size: usize,
+    /// Set once this rank has run tasks for rank 0 ([`Cluster::task_farm`]).
+    #[cfg(feature = "mpi")]
+    served: Arc<std::sync::atomic::AtomicBool>,
 }
 
 impl Cluster {
@@ -26,9 +32,8 @@ impl Cluster {
             let universe = mpi::initialize_with_threading(mpi::Threading::Funneled).map(|(u, _)| u);
             let (rank, size) =
                 universe.as_ref().map_or((0, 1), |u| (u.world().rank() as usize, u.world().size() as usize));
-            let evaluator =
-                (rank == 0 && size > 1).then(|| std::sync::Arc::new(czid_optimizers::mpi::MpiEvaluator::new()));
-            Cluster { _universe: universe, evaluator, rank, size }
+            let evaluator = (rank == 0 && size > 1).then(|| Arc::new(czid_optimizers::mpi::MpiEvaluator::new()));
+            Cluster { _universe: universe, evaluator, rank, size, served: Arc::default() }
         }
         #[cfg(not(feature = "mpi"))]
         Cluster { rank: 0 }
@@ -62,17 +67,34 @@ impl Cluster {
         }
     }
 
-    /// Where rank 0 runs a benchmark's cases (`None` on one rank).
-    pub fn case_farm(&self) -> Option<Box<dyn czid_problems::diagnose::bench::CaseFarm + '_>> {
+    /// Where tasks run (`None` on one rank): on rank 0, spread over every rank (rank 0 keeps the
+    /// results); on the others, the tasks rank 0 hands out are run until it is done, and the farm
+    /// gives no results ([`Cluster::served`] then tells so).
+    pub fn task_farm(&self) -> Option<Arc<dyn TaskFarm>> {
         #[cfg(feature = "mpi")]
-        if let Some(e) = &self.evaluator {
-            return Some(Box::new(MpiFarm(e)));
+        if self.size > 1 {
+            return Some(match &self.evaluator {
+                Some(e) => Arc::new(MpiFarm(e.clone())),
+                None => Arc::new(Served(self.served.clone())),
+            });
         }
         None
     }
 
+    /// Whether this rank has run tasks for rank 0 through its [`Cluster::task_farm`].
+    pub fn served(&self) -> bool {
+        #[cfg(feature = "mpi")]
+        {
+            self.served.load(std::sync::atomic::Ordering::SeqCst)
+        }
+        #[cfg(not(feature = "mpi"))]
+        {
+            false
+        }
+    }
+
     /// On a rank other than 0: runs the tasks rank 0 farms out with `run(id)`.
-    pub fn serve_tasks(&self, run: &dyn Fn(usize) -> String) -> Result<(), CzError> {
+    pub fn serve_tasks(&self, run: &dyn Fn(usize) -> Vec<u8>) -> Result<(), CzError> {
         #[cfg(feature = "mpi")]
         {
             czid_optimizers::mpi::serve_tasks(run);
@@ -100,13 +122,26 @@ impl Cluster {
     }
 }
 
-/// A benchmark's cases spread over the ranks.
+/// Rank 0's tasks (a benchmark's cases, a diagnosis's refits) spread over the ranks.
 #[cfg(feature = "mpi")]
-struct MpiFarm<'a>(&'a czid_optimizers::mpi::MpiEvaluator);
+struct MpiFarm(Arc<czid_optimizers::mpi::MpiEvaluator>);
 
 #[cfg(feature = "mpi")]
-impl czid_problems::diagnose::bench::CaseFarm for MpiFarm<'_> {
-    fn run(&self, indices: &[usize], run: &(dyn Fn(usize) -> String + Sync)) -> Vec<String> {
-        self.0.farm(indices, run)
+impl TaskFarm for MpiFarm {
+    fn run(&self, tasks: &[usize], run: &(dyn Fn(usize) -> Vec<u8> + Sync)) -> czid_core::Result<Option<Vec<Vec<u8>>>> {
+        Ok(Some(self.0.farm(tasks, run)))
+    }
+}
+
+/// Another rank's side of [`MpiFarm`]: runs what rank 0 hands out until it is done.
+#[cfg(feature = "mpi")]
+struct Served(Arc<std::sync::atomic::AtomicBool>);
+
+#[cfg(feature = "mpi")]
+impl TaskFarm for Served {
+    fn run(&self, _: &[usize], run: &(dyn Fn(usize) -> Vec<u8> + Sync)) -> czid_core::Result<Option<Vec<Vec<u8>>>> {
+        czid_optimizers::mpi::serve_tasks(run);
+        self.0.store(true, std::sync::atomic::Ordering::SeqCst);
+        Ok(None)
     }
 }

@@ -171,7 +171,14 @@ fn main() -> ExitCode {
             outcome
         }
         Command::Harness(args) => commands::harness::run(&args),
-        Command::Diagnose(args) => commands::diagnose::run(&args),
+        Command::Diagnose(args) => {
+            let cluster = Cluster::join();
+            let outcome = commands::diagnose::run(&args, &cluster);
+            if !cluster.is_worker() {
+                cluster.finish("refits");
+            }
+            outcome
+        }
         Command::GapBench(args) => {
             let cluster = Cluster::join();
             let outcome = commands::gap_bench::run(&args, &cluster);

@@ -8,7 +8,7 @@
 //! bit for bit.
 //!
 //! * [`MpiEvaluator`]: the batches of evaluations of an optimizer (a [`BatchEvaluator`]).
-//! * [`farm`]: tasks `0..n` whose results are strings (e.g. JSON).
+//! * [`MpiEvaluator::farm`]: whole tasks named by an index, whose results are bytes (e.g. JSON).
 //!
 //! Only rank 0's main thread calls MPI (`MPI_THREAD_FUNNELED` is enough); numbers cross as their
 //! bit patterns, so values arrive exactly.
@@ -166,11 +166,11 @@ impl MpiEvaluator {
 
     /// Runs the tasks `tasks` (any task ids) over the ranks (`run(id)` on rank 0, [`serve_tasks`]
     /// on the others) and returns their results in the order of `tasks`.
-    pub fn farm(&self, tasks: &[usize], run: &(dyn Fn(usize) -> String + Sync)) -> Vec<String> {
+    pub fn farm(&self, tasks: &[usize], run: &(dyn Fn(usize) -> Vec<u8> + Sync)) -> Vec<Vec<u8>> {
         let job = |k: usize| (tasks[k] as u64).to_le_bytes().to_vec();
-        let (results, counts) = schedule(tasks.len(), &job, &|k| run(tasks[k]).into_bytes());
+        let (results, counts) = schedule(tasks.len(), &job, &|k| run(tasks[k]));
         self.add(&counts);
-        results.into_iter().map(|b| String::from_utf8_lossy(&b).into_owned()).collect()
+        results
     }
 }
 
@@ -198,10 +198,10 @@ pub fn serve(problem: &dyn Problem) -> usize {
 
 /// Runs on ranks other than 0: does the tasks rank 0's [`MpiEvaluator::farm`] sends, with
 /// `run(id)`, until rank 0 says stop. Returns the number of tasks done.
-pub fn serve_tasks(run: &dyn Fn(usize) -> String) -> usize {
+pub fn serve_tasks(run: &dyn Fn(usize) -> Vec<u8>) -> usize {
     serve_with(&|_, payload| {
         let id = payload.try_into().map(u64::from_le_bytes).unwrap_or(u64::MAX) as usize;
-        run(id).into_bytes()
+        run(id)
     })
 }
 
