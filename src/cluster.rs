@@ -3,6 +3,11 @@
 //! its tasks (gap-bench's cases, a diagnosis's refits) over every rank; the other ranks read the
 //! same input, build the same problem, plan or diagnosis and do what rank 0 sends until it is
 //! done. Without the feature, or on one rank, nothing changes.
+//!
+//! A rank that fails ends every rank: it prints its error (or panic) with its number and exits
+//! without finalising MPI ([`Cluster::abort`]), and `mpiexec` then ends the other ranks. A rank
+//! that finalised and returned would leave the others waiting for it; `MPI_Abort` can lose the
+//! message.
 
 use czid_core::{CzError, Problem};
 use czid_problems::farm::TaskFarm;
@@ -33,6 +38,16 @@ impl Cluster {
             let (rank, size) =
                 universe.as_ref().map_or((0, 1), |u| (u.world().rank() as usize, u.world().size() as usize));
             let evaluator = (rank == 0 && size > 1).then(|| Arc::new(czid_optimizers::mpi::MpiEvaluator::new()));
+            if size > 1 {
+                // Unwinding would finalise MPI while the other ranks wait for this one; a process
+                // that exits without finalising ends them all.
+                let report = std::panic::take_hook();
+                std::panic::set_hook(Box::new(move |info| {
+                    eprintln!("rank {rank} of {size} panicked; ending every rank");
+                    report(info);
+                    std::process::exit(101);
+                }));
+            }
             Cluster { _universe: universe, evaluator, rank, size, served: Arc::default() }
         }
         #[cfg(not(feature = "mpi"))]
@@ -91,6 +106,29 @@ impl Cluster {
         {
             false
         }
+    }
+
+    /// Whether several ranks run the command.
+    pub fn is_spread(&self) -> bool {
+        #[cfg(feature = "mpi")]
+        {
+            self.size > 1
+        }
+        #[cfg(not(feature = "mpi"))]
+        {
+            false
+        }
+    }
+
+    /// Ends the run on every rank after `e`, printed with this rank's number: the process exits
+    /// without finalising MPI, and `mpiexec` ends the other ranks (a rank that returned would
+    /// leave them waiting for it).
+    pub fn abort(&self, e: &CzError) -> ! {
+        #[cfg(feature = "mpi")]
+        eprintln!("error on rank {} of {}: {e}", self.rank, self.size);
+        #[cfg(not(feature = "mpi"))]
+        eprintln!("error: {e}");
+        std::process::exit(1)
     }
 
     /// On a rank other than 0: runs the tasks rank 0 farms out with `run(id)`.
