@@ -121,6 +121,13 @@ fn schedule(
     (results.into_inner().unwrap_or_default(), counts)
 }
 
+/// How long a waiting rank polls for its next message before it starts sleeping between polls:
+/// within a batch the next job follows a result at once, and a blocking receive would keep the
+/// core busy for as long as rank 0 works alone (e.g. the end of a diagnosis).
+const SPIN: std::time::Duration = std::time::Duration::from_millis(2);
+/// The sleep between polls after that.
+const NAP: std::time::Duration = std::time::Duration::from_micros(500);
+
 /// Serves rank 0 on another rank: answers each job with `handle(index, payload)` until told to
 /// stop. Returns the number of jobs done.
 fn serve_with(handle: &dyn Fn(usize, &[u8]) -> Vec<u8>) -> usize {
@@ -128,6 +135,14 @@ fn serve_with(handle: &dyn Fn(usize, &[u8]) -> Vec<u8>) -> usize {
     let root = world.process_at_rank(0);
     let mut done_here = 0;
     loop {
+        let since = std::time::Instant::now();
+        while root.immediate_probe().is_none() {
+            if since.elapsed() < SPIN {
+                std::hint::spin_loop();
+            } else {
+                std::thread::sleep(NAP);
+            }
+        }
         let (msg, status) = root.receive_vec::<u8>();
         if status.tag() == STOP {
             return done_here;
