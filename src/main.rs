@@ -150,12 +150,12 @@ struct OutArgs {
 }
 
 /// A rank other than 0: builds the same problem as rank 0 (only rank 0 writes anything) and
-/// evaluates what it sends.
+/// evaluates what it sends; a failure ends every rank.
 fn serve(cluster: &Cluster, problem: &Path, sets: &[(String, String)], leave_out: &[String]) -> ExitCode {
     let problem = LoadedProblem::read_with(problem, sets).and_then(|mut p| p.leave_out(leave_out).map(|()| p));
     match problem.and_then(|p| p.identification()).and_then(|id| cluster.serve(&id)) {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => fail(&e),
+        Err(e) => cluster.abort(&e),
     }
 }
 
@@ -200,12 +200,27 @@ fn main() -> ExitCode {
             outcome
         }
         Command::Harness(args) => commands::harness::run(&args),
-        Command::Diagnose(args) => commands::diagnose::run(&args),
+        Command::Diagnose(args) => {
+            let cluster = Cluster::join();
+            let outcome = commands::diagnose::run(&args, &cluster);
+            match outcome {
+                // The other ranks may still be building the diagnosis, or waiting for refits.
+                Err(e) if cluster.is_spread() => cluster.abort(&e),
+                outcome => {
+                    if !cluster.is_worker() {
+                        cluster.finish("refits");
+                    }
+                    outcome
+                }
+            }
+        }
         Command::GapBench(args) => {
             let cluster = Cluster::join();
             let outcome = commands::gap_bench::run(&args, &cluster);
             if !cluster.is_worker() {
                 cluster.finish("cases");
+            } else if let Err(e) = &outcome {
+                cluster.abort(e);
             }
             outcome
         }

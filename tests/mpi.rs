@@ -1,5 +1,6 @@
 //! `mpiexec -n 2 czid identify ...` gives the serial result bit for bit, with evaluations done on
-//! both ranks, and a killed 2-rank run resumes to it (on one rank as well). Built and run with
+//! both ranks, and a killed 2-rank run resumes to it (on one rank as well); `compare`, `gap-bench`
+//! and `diagnose` give their serial outputs on 2 ranks too. Built and run with
 //! `cargo test --features mpi --test mpi` on a machine with MPI (`mpiexec` on the path).
 #![cfg(feature = "mpi")]
 
@@ -149,6 +150,68 @@ fn gap_bench_cases_spread_over_two_ranks_give_the_serial_cases() {
             v
         };
         assert_eq!(read(&two), read(&serial), "{name}");
+    }
+    for d in [serial, two] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}
+
+#[test]
+fn diagnose_refits_spread_over_two_ranks_give_the_serial_diagnosis() {
+    let bin = env!("CARGO_BIN_EXE_czid");
+    // Four cheap candidates, all refitted; the cause's refit is judged again with the model-form
+    // floor re-estimated, and the held-out late stage is predicted (about 5 s serial).
+    let args = |out: &Path| {
+        [
+            "diagnose",
+            "examples/hartlen-dcb/dcb01.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "models.dcb01.control.max_displacement=12",
+            "--set",
+            "optimizer.budget=8",
+            "--candidates",
+            "machine_compliance,crack_length_offset,displacement_offset,load_offset",
+            "--refit",
+            "4",
+        ]
+        .map(str::to_string)
+    };
+    let serial = scratch("diagnose-serial");
+    let o = Command::new(bin).args(args(&serial)).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let two = scratch("diagnose-two");
+    let o = Command::new("mpiexec")
+        .args(["-n", "2", bin])
+        .args(args(&two))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Both ranks refitted: "refits on 2 ranks: rank 0: a, rank 1: b" with a + b = 4, a, b > 0.
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout.lines().find(|l| l.starts_with("refits on 2 ranks")).expect("the per-rank counts");
+    let counts: Vec<usize> =
+        line.split(": ").skip(2).map(|c| c.split(',').next().unwrap().trim().parse().unwrap()).collect();
+    assert!(counts.len() == 2 && counts.iter().all(|&c| c > 0) && counts.iter().sum::<usize>() == 4, "{line}");
+    let gap = |d: &Path| {
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("gap.json")).unwrap()).unwrap();
+        v.as_object_mut().unwrap().remove("wall_seconds");
+        v
+    };
+    let (g2, g1) = (gap(&two), gap(&serial));
+    assert_eq!(g2, g1);
+    // The case is what it should exercise: four refits, a cause judged again, transfer checked.
+    let refitted = g1["candidates"].as_array().unwrap().iter().filter(|c| c["refit"].is_object()).count();
+    assert_eq!(refitted, 4, "{}", g1["candidates"]);
+    assert_eq!(g1["outcome"]["kind"], "cause", "{}", g1["outcome"]);
+    let cause = g1["candidates"].as_array().unwrap().iter().find(|c| c["name"] == g1["outcome"]["cause"]).unwrap();
+    assert!(cause["refit"]["chi2_reestimated"].is_f64() && cause["transfer"][0]["shrinkage"].is_f64(), "{cause}");
+    // The plots, the cause's refit among them, byte for byte.
+    for name in ["fit-dcb01-F.png", "fit-dcb01-L.png", "residual-dcb01-F.png", "scores.png"] {
+        assert!(std::fs::read(two.join(name)).unwrap() == std::fs::read(serial.join(name)).unwrap(), "{name}");
     }
     for d in [serial, two] {
         std::fs::remove_dir_all(d).ok();

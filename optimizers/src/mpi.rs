@@ -8,7 +8,7 @@
 //! bit for bit.
 //!
 //! * [`MpiEvaluator`]: the batches of evaluations of an optimizer (a [`BatchEvaluator`]).
-//! * [`farm`]: tasks `0..n` whose results are strings (e.g. JSON).
+//! * [`MpiEvaluator::farm`]: whole tasks named by an index, whose results are bytes (e.g. JSON).
 //!
 //! Only rank 0's main thread calls MPI (`MPI_THREAD_FUNNELED` is enough); numbers cross as their
 //! bit patterns, so values arrive exactly.
@@ -121,6 +121,13 @@ fn schedule(
     (results.into_inner().unwrap_or_default(), counts)
 }
 
+/// How long a waiting rank polls for its next message before it starts sleeping between polls:
+/// within a batch the next job follows a result at once, and a blocking receive would keep the
+/// core busy for as long as rank 0 works alone (e.g. the end of a diagnosis).
+const SPIN: std::time::Duration = std::time::Duration::from_millis(2);
+/// The sleep between polls after that.
+const NAP: std::time::Duration = std::time::Duration::from_micros(500);
+
 /// Serves rank 0 on another rank: answers each job with `handle(index, payload)` until told to
 /// stop. Returns the number of jobs done.
 fn serve_with(handle: &dyn Fn(usize, &[u8]) -> Vec<u8>) -> usize {
@@ -128,6 +135,14 @@ fn serve_with(handle: &dyn Fn(usize, &[u8]) -> Vec<u8>) -> usize {
     let root = world.process_at_rank(0);
     let mut done_here = 0;
     loop {
+        let since = std::time::Instant::now();
+        while root.immediate_probe().is_none() {
+            if since.elapsed() < SPIN {
+                std::hint::spin_loop();
+            } else {
+                std::thread::sleep(NAP);
+            }
+        }
         let (msg, status) = root.receive_vec::<u8>();
         if status.tag() == STOP {
             return done_here;
@@ -166,11 +181,11 @@ impl MpiEvaluator {
 
     /// Runs the tasks `tasks` (any task ids) over the ranks (`run(id)` on rank 0, [`serve_tasks`]
     /// on the others) and returns their results in the order of `tasks`.
-    pub fn farm(&self, tasks: &[usize], run: &(dyn Fn(usize) -> String + Sync)) -> Vec<String> {
+    pub fn farm(&self, tasks: &[usize], run: &(dyn Fn(usize) -> Vec<u8> + Sync)) -> Vec<Vec<u8>> {
         let job = |k: usize| (tasks[k] as u64).to_le_bytes().to_vec();
-        let (results, counts) = schedule(tasks.len(), &job, &|k| run(tasks[k]).into_bytes());
+        let (results, counts) = schedule(tasks.len(), &job, &|k| run(tasks[k]));
         self.add(&counts);
-        results.into_iter().map(|b| String::from_utf8_lossy(&b).into_owned()).collect()
+        results
     }
 }
 
@@ -198,10 +213,10 @@ pub fn serve(problem: &dyn Problem) -> usize {
 
 /// Runs on ranks other than 0: does the tasks rank 0's [`MpiEvaluator::farm`] sends, with
 /// `run(id)`, until rank 0 says stop. Returns the number of tasks done.
-pub fn serve_tasks(run: &dyn Fn(usize) -> String) -> usize {
+pub fn serve_tasks(run: &dyn Fn(usize) -> Vec<u8>) -> usize {
     serve_with(&|_, payload| {
         let id = payload.try_into().map(u64::from_le_bytes).unwrap_or(u64::MAX) as usize;
-        run(id).into_bytes()
+        run(id)
     })
 }
 

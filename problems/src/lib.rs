@@ -6,6 +6,7 @@
 //!   composite objective as a [`czid_core::Problem`] on the unit cube.
 //! * [`diagnose`]: where a fitted model misses the test, which unmodelled effect most likely
 //!   causes it, and how far the misfit shrinks once it is added.
+//! * [`farm`]: independent tasks run side by side, on threads or spread over processes.
 //! * [`identify`]: the `identify` and `simulate` workflows, writing results, fits and plots.
 //! * [`identifiability`]: standard errors, correlations and a verdict per identified parameter.
 //! * [`output`]: output folders that are never clobbered by accident, files written atomically.
@@ -18,6 +19,7 @@
 pub mod compare;
 pub mod data;
 pub mod diagnose;
+pub mod farm;
 pub mod identifiability;
 pub mod identification;
 pub mod identify;

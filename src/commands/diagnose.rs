@@ -5,8 +5,13 @@
 //! czid diagnose examples/hartlen-dcb/dcb01.toml --out out/gap-dcb01 \
 //!     --withheld examples/hartlen-dcb/dcb02.toml,examples/hartlen-dcb/dcb03.toml
 //! czid diagnose PROBLEM --out DIR --from out/fit/result.json --candidates fibre_bridging,large_rotation
+//! mpiexec -n 4 czid diagnose examples/hartlen-dcb/dcb01.toml --out out/gap-dcb01
 //! ```
+//!
+//! On several MPI ranks every rank builds the same diagnosis up to the refits, which rank 0 then
+//! hands out to whichever rank is free; rank 0 writes everything.
 
+use crate::cluster::Cluster;
 use czid_core::CzError;
 use czid_problems::diagnose::{self, Library, NoiseLevels, Options};
 use czid_problems::output::OutputDir;
@@ -77,20 +82,20 @@ fn read_start(path: &Path, problem: &LoadedProblem) -> Result<Vec<f64>, CzError>
         .collect()
 }
 
-/// Runs the diagnosis and writes its outputs.
-pub fn run(args: &DiagnoseArgs) -> Result<(), CzError> {
+/// Runs the diagnosis and writes its outputs (on rank 0; the other ranks run refits for it).
+pub fn run(args: &DiagnoseArgs, cluster: &Cluster) -> Result<(), CzError> {
     let problem = LoadedProblem::read_with(&args.problem, &args.sets)?;
-    for note in problem.reading_notes() {
-        eprintln!("note: {note}");
+    if !cluster.is_worker() {
+        for note in problem.reading_notes() {
+            eprintln!("note: {note}");
+        }
     }
     let library = Library::builtin();
     // Unknown candidate names are reported before any work.
     library.select(&problem.setup()?, &args.candidates)?;
     let withheld = args.withheld.iter().map(|p| LoadedProblem::read(p)).collect::<Result<Vec<_>, _>>()?;
     let start = args.from.as_ref().map(|p| read_start(p, &problem)).transpose()?;
-    let dir = OutputDir::create(&args.out, args.force, false)?;
-    let clock = Instant::now();
-    let opts = Options {
+    let mut opts = Options {
         candidates: args.candidates.clone(),
         start,
         refit: args.refit,
@@ -99,8 +104,19 @@ pub fn run(args: &DiagnoseArgs) -> Result<(), CzError> {
         holdout: !args.no_holdout,
         always_refit: Vec::new(),
         model_form: !args.no_model_form,
-        progress: Some(Box::new(move |m: &str| eprintln!("[{:6.1} s] {m}", clock.elapsed().as_secs_f64()))),
+        progress: None,
+        farm: cluster.task_farm(),
     };
+    if cluster.is_worker() {
+        // The same diagnosis as rank 0 up to the refits, then the refits rank 0 hands out.
+        return match diagnose::diagnose(&problem, &library, &opts) {
+            Err(_) if cluster.served() => Ok(()),
+            outcome => outcome.map(|_| ()),
+        };
+    }
+    let dir = OutputDir::create(&args.out, args.force, false)?;
+    let clock = Instant::now();
+    opts.progress = Some(Box::new(move |m: &str| eprintln!("[{:6.1} s] {m}", clock.elapsed().as_secs_f64())));
     let d = diagnose::diagnose(&problem, &library, &opts)?;
     diagnose::report::write(&d, &dir)?;
     println!("{}", d.verdict);

@@ -58,9 +58,9 @@ pub fn run(args: &GapBenchArgs, cluster: &Cluster) -> Result<(), CzError> {
     };
     if cluster.is_worker() {
         let plan = bench::Plan::new(&opts)?;
-        return cluster.serve_tasks(&|i| plan.run_case_json(i));
+        return cluster.serve_tasks(&|i| plan.run_case_json(i).into_bytes());
     }
-    let farm = cluster.case_farm();
+    let farm = cluster.task_farm();
     let dir = OutputDir::create(&args.out, args.force, args.resume)?;
     let store = CaseStore { dir: OutputDir::create(&dir.file("cases"), true, true)?, reuse: args.resume };
     let bar = indicatif::ProgressBar::new(0);

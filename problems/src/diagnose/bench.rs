@@ -16,6 +16,7 @@ use crate::data::Experiment;
 use crate::diagnose::candidate::{CandidateEffect, Library};
 use crate::diagnose::run::{diagnose_subject, Diagnosis, Options, Subject};
 use crate::diagnose::stats::chi2_survival;
+use crate::farm::TaskFarm;
 use crate::identification::Setup;
 use crate::output::OutputDir;
 use crate::synthetic::{synthesize, Noise};
@@ -364,13 +365,6 @@ pub struct CaseStore {
     pub reuse: bool,
 }
 
-/// Where the cases of a benchmark run: this process's threads by default, or spread (e.g. over
-/// MPI ranks, each holding the same [`Plan`]). Result `k` is case `k`'s [`CaseResult`] as JSON.
-pub trait CaseFarm: Sync {
-    /// Runs the cases `indices` (`run(k)` gives case `k`'s JSON) and returns their JSON in order.
-    fn run(&self, indices: &[usize], run: &(dyn Fn(usize) -> String + Sync)) -> Vec<String>;
-}
-
 /// What a benchmark runs: the planted effect of every case, and how to run one.
 pub struct Plan {
     opts: BenchOptions,
@@ -441,7 +435,7 @@ impl Plan {
         case(i, p, effect, self.opts.seed, self.opts.family, self.opts.truth, &self.library)
     }
 
-    /// Runs case `i` and gives its result as JSON (what a [`CaseFarm`] moves).
+    /// Runs case `i` and gives its result as JSON (what a [`TaskFarm`] moves).
     pub fn run_case_json(&self, i: usize) -> String {
         serde_json::to_string(&self.run_case(i)).unwrap_or_default()
     }
@@ -454,7 +448,7 @@ impl Plan {
 pub fn run(
     opts: &BenchOptions,
     store: Option<&CaseStore>,
-    farm: Option<&dyn CaseFarm>,
+    farm: Option<&dyn TaskFarm>,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<BenchReport> {
     let clock = std::time::Instant::now();
@@ -492,9 +486,11 @@ pub fn run(
             .collect(),
         Some(farm) => {
             let todo: Vec<usize> = (0..total).filter(|&i| kept[i].is_none()).collect();
-            let json = farm.run(&todo, &|i| plan.run_case_json(i));
+            let json = farm
+                .run(&todo, &|i| plan.run_case_json(i).into_bytes())?
+                .ok_or_else(|| CzError::config("gap-bench", "the cases are kept by another process"))?;
             let mut fresh = todo.iter().zip(json).map(|(&i, j)| {
-                let r = serde_json::from_str::<CaseResult>(&j)
+                let r = serde_json::from_slice::<CaseResult>(&j)
                     .map_err(|e| CzError::Simulation(format!("case {i} came back unreadable from its rank: {e}")))?;
                 keep(i, &r);
                 Ok::<_, CzError>((i, r))

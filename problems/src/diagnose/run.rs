@@ -8,6 +8,7 @@ use crate::diagnose::stages::model_form::{self, ModelForm};
 use crate::diagnose::stages::transfer::{Holdout, Withheld};
 use crate::diagnose::stages::verdict::{self as decide, Outcome};
 use crate::diagnose::stages::{base, ranking, refit};
+use crate::farm::{TaskFarm, Threads};
 use crate::identification::{Setup, Term};
 use crate::identify::optimize;
 use crate::problem_file::LoadedProblem;
@@ -48,6 +49,10 @@ pub struct Options {
     pub model_form: bool,
     /// Called with a short message as each stage starts (e.g. for a progress display).
     pub progress: Option<ProgressFn>,
+    /// Where the candidates' refits run (`None`: this process's threads); e.g. spread over MPI
+    /// ranks that each build the same diagnosis up to the refits. The diagnosis is the same
+    /// wherever they run.
+    pub farm: Option<std::sync::Arc<dyn TaskFarm>>,
 }
 
 impl Default for Options {
@@ -62,6 +67,7 @@ impl Default for Options {
             always_refit: Vec::new(),
             model_form: true,
             progress: None,
+            farm: None,
         }
     }
 }
@@ -396,7 +402,12 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     let withheld = Withheld::prepare(&base, &opts.withheld, opts.noise)?;
     let above_noise = base.p_noise <= NOISE_LEVEL;
     let todo = ranking.to_refit(opts.refit, above_noise, &opts.always_refit);
-    let mut refits = refit_candidates(&base, &lin, &regs, &mut ranking, &todo, (holdout.as_ref(), &withheld), &say);
+    let farm = opts.farm.as_deref().unwrap_or(&Threads);
+    let Some(mut refits) =
+        refit_candidates(&base, &lin, &regs, &mut ranking, &todo, (holdout.as_ref(), &withheld), &say, farm)?
+    else {
+        return Err(CzError::config("diagnose", "this process ran refits for another one, which keeps the diagnosis"));
+    };
     let ranking::Ranking { ranked, skipped, pairs, confusable } = ranking;
     let mut candidates: Vec<CandidateResult> = ranked.into_iter().map(|r| r.result).collect();
     let base_fit = BaseFit {
@@ -478,13 +489,13 @@ fn reestimated(
 
 /// A refitted candidate: the effect, its parameters and the refit.
 type Refitted = (std::sync::Arc<dyn crate::diagnose::CandidateEffect>, Vec<Parameter>, refit::RefitOutcome);
-/// A candidate's refit report, its transfer checks and the refit.
-type RefitDone = (Refit, Vec<Transfer>, Refitted);
 
-/// Refits the candidates `todo` of `ranking` side by side (each refit runs one simulation per
-/// step, so one refit alone leaves cores idle), checks their transfer, and writes the results
-/// into the ranking; returns the refits by candidate name. The results do not depend on the
-/// order the refits finish in.
+/// Refits the candidates `todo` of `ranking` side by side through `farm` (each refit runs one
+/// simulation per step, so one refit alone leaves cores idle), checks their transfer, and writes
+/// the results into the ranking; returns the refits by candidate name (`None` on a process that
+/// only ran refits for another one). The results do not depend on where or in which order the
+/// refits run: each crosses as its bit patterns ([`wire`]) and is stored under its candidate.
+#[allow(clippy::too_many_arguments)]
 fn refit_candidates(
     base: &base::Base,
     lin: &crate::diagnose::score::Linearisation,
@@ -493,44 +504,230 @@ fn refit_candidates(
     todo: &[usize],
     (holdout, withheld): (Option<&Holdout>, &[Withheld]),
     say: &(dyn Fn(&str) + Sync),
-) -> BTreeMap<String, Refitted> {
-    use rayon::prelude::*;
+    farm: &dyn TaskFarm,
+) -> Result<Option<BTreeMap<String, Refitted>>> {
     let ranked = &ranking.ranked;
-    let done: Vec<(usize, std::result::Result<RefitDone, String>)> = todo
-        .par_iter()
-        .map(|&i| {
-            let entry = &ranked[i];
-            let c = entry.effect.clone();
-            say(&format!("refitting with {}", c.name()));
-            let (sens, score) =
-                (entry.sensitivity.as_ref().expect("scored"), entry.result.score.as_ref().expect("scored"));
-            let out = match refit::refit(base, lin, c.as_ref(), sens, score) {
-                Ok(o) => o,
-                Err(e) => return (i, Err(format!("refit failed: {e}"))),
-            };
+    let task = |i: usize| -> Vec<u8> {
+        let entry = &ranked[i];
+        let c = entry.effect.as_ref();
+        say(&format!("refitting with {}", c.name()));
+        let (sens, score) = (entry.sensitivity.as_ref().expect("scored"), entry.result.score.as_ref().expect("scored"));
+        let done = refit::refit(base, lin, c, sens, score).map_err(|e| format!("refit failed: {e}")).map(|out| {
             let report = refit::report(base, regs, entry, &out);
             let params: Vec<Parameter> = sens.parameters.iter().map(|q| q.parameter.clone()).collect();
             let mut transfer = Vec::new();
             if let Some(h) = holdout {
-                transfer.push(h.check(base, c.as_ref(), &params, &out, report.shrinkage, say));
+                transfer.push(h.check(base, c, &params, &out, report.shrinkage, say));
             }
             let effect: Vec<f64> = report.effect.iter().map(|v| v.value).collect();
             let x: Vec<f64> = report.parameters.iter().map(|v| v.value).collect();
-            transfer.extend(withheld.iter().map(|w| w.predict(c.as_ref(), &x, &effect)));
-            (i, Ok((report, transfer, (c, params, out))))
-        })
-        .collect();
+            transfer.extend(withheld.iter().map(|w| w.predict(c, &x, &effect)));
+            (out, transfer)
+        });
+        wire::encode(&entry.result.name, done)
+    };
+    let Some(done) = farm.run(todo, &task)? else { return Ok(None) };
     let mut refits = BTreeMap::new();
-    for (i, d) in done {
+    for (&i, bytes) in todo.iter().zip(done) {
         let entry = &mut ranking.ranked[i];
-        match d {
-            Ok((report, transfer, refitted)) => {
+        match wire::decode(&entry.result.name, &bytes)? {
+            Ok((out, transfer)) => {
+                // The report is made again here from the refit itself, as where it ran.
+                let report = refit::report(base, regs, entry, &out);
+                let sens = entry.sensitivity.as_ref().expect("scored");
+                let params: Vec<Parameter> = sens.parameters.iter().map(|q| q.parameter.clone()).collect();
                 entry.result.refit = Some(report);
                 entry.result.transfer.extend(transfer);
-                refits.insert(entry.result.name.clone(), refitted);
+                refits.insert(entry.result.name.clone(), (entry.effect.clone(), params, out));
             }
             Err(e) => entry.result.error = Some(e),
         }
     }
-    refits
+    Ok(Some(refits))
+}
+
+/// A refit as it crosses between processes: its candidate's name (checked on arrival: every
+/// process must have ranked the same candidates), then the refit and its transfer checks, or why
+/// it failed; floating values as their bit patterns, so they arrive exactly.
+mod wire {
+    use super::Transfer;
+    use crate::diagnose::gauge::Misfit;
+    use crate::diagnose::stages::refit::RefitOutcome;
+    use crate::farm::{bits, values};
+    use czid_core::{CzError, Record, Result};
+    use nalgebra::DMatrix;
+    use serde::{Deserialize, Serialize};
+
+    /// A refit and its transfer checks, or why the refit failed.
+    pub type Done = std::result::Result<(RefitOutcome, Vec<Transfer>), String>;
+
+    #[derive(Serialize, Deserialize)]
+    struct Message {
+        name: String,
+        done: std::result::Result<RefitBits, String>,
+    }
+
+    /// A column of a record: name, unit, values.
+    type ColumnBits = (String, String, Vec<u64>);
+
+    #[derive(Serialize, Deserialize)]
+    struct RefitBits {
+        v: Vec<u64>,
+        r: Vec<u64>,
+        records: Vec<(String, Vec<ColumnBits>)>,
+        failures: Vec<String>,
+        evaluations: usize,
+        /// Rows, columns, values column by column.
+        jacobian: Option<(usize, usize, Vec<u64>)>,
+        transfer: Vec<TransferBits>,
+    }
+
+    #[derive(Serialize, Deserialize)]
+    struct TransferBits {
+        withheld: String,
+        readings: usize,
+        base_chi2: u64,
+        effect_chi2: Option<u64>,
+        shrinkage: Option<u64>,
+        note: Option<String>,
+    }
+
+    fn record(columns: Vec<ColumnBits>) -> Record {
+        let spec: Vec<(&str, &str)> = columns.iter().map(|(n, u, _)| (n.as_str(), u.as_str())).collect();
+        let mut r = Record::new(&spec);
+        let rows = columns.first().map_or(0, |c| c.2.len());
+        for i in 0..rows {
+            r.push(&columns.iter().map(|c| f64::from_bits(c.2[i])).collect::<Vec<f64>>());
+        }
+        r
+    }
+
+    /// The message of candidate `name`'s refit.
+    pub fn encode(name: &str, done: Done) -> Vec<u8> {
+        let done = done.map(|(o, transfer)| RefitBits {
+            v: bits(&o.v),
+            r: bits(&o.misfit.r),
+            records: o
+                .misfit
+                .records
+                .iter()
+                .map(|(k, rec)| {
+                    let columns = rec.columns().iter().map(|c| (c.name.clone(), c.unit.clone(), bits(&c.values)));
+                    (k.clone(), columns.collect())
+                })
+                .collect(),
+            failures: o.misfit.failures,
+            evaluations: o.evaluations,
+            jacobian: o.jacobian.map(|j| (j.nrows(), j.ncols(), bits(j.as_slice()))),
+            transfer: transfer
+                .into_iter()
+                .map(|t| TransferBits {
+                    withheld: t.withheld,
+                    readings: t.readings,
+                    base_chi2: t.base_chi2.to_bits(),
+                    effect_chi2: t.effect_chi2.map(f64::to_bits),
+                    shrinkage: t.shrinkage.map(f64::to_bits),
+                    note: t.note,
+                })
+                .collect(),
+        });
+        serde_json::to_vec(&Message { name: name.to_string(), done }).expect("plain data serialises")
+    }
+
+    /// Candidate `name`'s refit from its message; an error when the message is unreadable or
+    /// belongs to another candidate.
+    pub fn decode(name: &str, bytes: &[u8]) -> Result<Done> {
+        let m: Message = serde_json::from_slice(bytes)
+            .map_err(|e| CzError::Simulation(format!("the refit of {name} came back unreadable: {e}")))?;
+        if m.name != name {
+            return Err(CzError::Simulation(format!(
+                "the refit of {name} came back as {}'s: the processes ranked the candidates differently",
+                m.name
+            )));
+        }
+        Ok(m.done.map(|b| {
+            let misfit = Misfit {
+                r: values(&b.r),
+                records: b.records.into_iter().map(|(k, c)| (k, record(c))).collect(),
+                failures: b.failures,
+            };
+            let jacobian = b.jacobian.map(|(n, m, v)| DMatrix::from_vec(n, m, values(&v)));
+            let outcome = RefitOutcome { v: values(&b.v), misfit, evaluations: b.evaluations, jacobian };
+            let transfer = b
+                .transfer
+                .into_iter()
+                .map(|t| Transfer {
+                    withheld: t.withheld,
+                    readings: t.readings,
+                    base_chi2: f64::from_bits(t.base_chi2),
+                    effect_chi2: t.effect_chi2.map(f64::from_bits),
+                    shrinkage: t.shrinkage.map(f64::from_bits),
+                    note: t.note,
+                })
+                .collect();
+            (outcome, transfer)
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wire;
+    use crate::diagnose::gauge::Misfit;
+    use crate::diagnose::run::Transfer;
+    use crate::diagnose::stages::refit::RefitOutcome;
+    use czid_core::Record;
+    use nalgebra::DMatrix;
+
+    fn same(a: &[f64], b: &[f64]) -> bool {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+    }
+
+    #[test]
+    fn a_refit_crosses_between_processes_bit_for_bit() {
+        let awkward = [0.1 + 0.2, -0.0, f64::MIN_POSITIVE / 7.0, f64::NAN, 1.0 / 3.0];
+        let mut rec = Record::new(&[("displacement", "mm"), ("load", "N")]);
+        rec.push(&[0.0, 1.0 / 3.0]);
+        rec.push(&[2.0f64.sqrt(), f64::INFINITY]);
+        let out = RefitOutcome {
+            v: awkward.to_vec(),
+            misfit: Misfit {
+                r: awkward.iter().map(|x| x * 7.1).collect(),
+                records: [("dcb01".to_string(), rec.clone())].into(),
+                failures: vec!["stopped early".into()],
+            },
+            evaluations: 17,
+            jacobian: Some(DMatrix::from_fn(3, 2, |i, j| (i as f64 + 0.1) / (j as f64 + 0.7))),
+        };
+        let transfer = Transfer {
+            withheld: "dcb02".into(),
+            readings: 40,
+            base_chi2: 0.1 + 0.7,
+            effect_chi2: Some(1.0 / 9.0),
+            shrinkage: None,
+            note: Some("n".into()),
+        };
+        let bytes = wire::encode("fibre_bridging", Ok((out, vec![transfer.clone()])));
+        let (back, t) = wire::decode("fibre_bridging", &bytes).unwrap().unwrap();
+        assert!(same(&back.v, &awkward));
+        assert!(same(&back.misfit.r, &awkward.map(|x| x * 7.1)));
+        assert_eq!(back.misfit.records["dcb01"].columns(), rec.columns());
+        assert!(same(back.misfit.records["dcb01"].column("load").unwrap(), &[1.0 / 3.0, f64::INFINITY]));
+        assert_eq!(back.misfit.failures, ["stopped early"]);
+        assert_eq!(back.evaluations, 17);
+        let j = back.jacobian.unwrap();
+        assert!(
+            j.shape() == (3, 2)
+                && same(j.as_slice(), DMatrix::from_fn(3, 2, |i, j| (i as f64 + 0.1) / (j as f64 + 0.7)).as_slice())
+        );
+        assert_eq!(t.len(), 1);
+        assert_eq!(t[0].base_chi2.to_bits(), transfer.base_chi2.to_bits());
+        assert_eq!((t[0].effect_chi2, t[0].shrinkage, &t[0].note), (transfer.effect_chi2, None, &transfer.note));
+        // A failed refit, and a message that belongs to another candidate.
+        let failed = wire::encode("large_rotation", Err("refit failed: no".into()));
+        assert_eq!(wire::decode("large_rotation", &failed).unwrap().err().unwrap(), "refit failed: no");
+        let e = wire::decode("fibre_bridging", &failed).err().unwrap().to_string();
+        assert!(e.contains("ranked the candidates differently"), "{e}");
+        assert!(wire::decode("x", b"{").is_err());
+    }
 }
