@@ -351,8 +351,9 @@ fn run_identify(
 
 fn run_predict(problem: &Path, from: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
     let problem = read_problem(problem, sets)?;
+    let calibration = czid_problems::predict::Calibration::read(&problem, from)?;
     let dir = OutputDir::create(&out.out, out.force, false)?;
-    let p = czid_problems::predict::predict(&problem, from, &dir)?;
+    let p = czid_problems::predict::predict(&problem, &calibration, &dir)?;
     for (path, v) in &p.parameters {
         println!("  {path:<28} = {v:>12.6e}");
     }

@@ -261,3 +261,76 @@ fn a_test_driven_past_the_specimen_split_ends_there_without_bogus_rows() {
     assert!(tip > 123.0 - 4.4 && tip < 123.0, "last crack tip {tip}");
     std::fs::remove_dir_all(&out).ok();
 }
+
+#[test]
+fn a_held_out_specimen_is_predicted_at_the_values_calibrated_on_the_others() {
+    let (cal, pred) = (scratch("loo-calibrate"), scratch("loo-predict"));
+    let coarse = |name: &str| format!("models.{name}.mesh.interface_element=0.5");
+    let sets: Vec<String> = ["dcb01", "dcb02", "dcb03"].iter().map(|n| coarse(n)).collect();
+    let mut args = vec![
+        "identify",
+        "examples/hartlen-dcb/joint.toml",
+        "--leave-out",
+        "dcb03",
+        "--optimizer",
+        "nelder-mead",
+        "--budget",
+        "6",
+        "--out",
+        cal.to_str().unwrap(),
+    ];
+    for s in &sets[..2] {
+        args.extend(["--set", s.as_str()]);
+    }
+    let r = czid(&args);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(cal.join("result.json")).unwrap()).unwrap();
+    // The calibration saw two specimens; its errors are in N and mm, with % of each test's peak.
+    let errors = result["rms_error"].as_object().unwrap();
+    assert_eq!(errors.keys().cloned().collect::<Vec<_>>(), ["F:dcb01", "F:dcb02", "L:dcb01", "L:dcb02"]);
+    assert_eq!(errors["F:dcb01"]["unit"], "N");
+    assert!(errors["F:dcb01"]["percent_of_peak"].as_f64().unwrap() > 0.0);
+
+    let from = cal.join("result.json");
+    let mut args = vec!["predict", "examples/hartlen-dcb/joint.toml", "--from", from.to_str().unwrap()];
+    args.extend(["--out", pred.to_str().unwrap()]);
+    for s in &sets {
+        args.extend(["--set", s.as_str()]);
+    }
+    let r = czid(&args);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let p: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(pred.join("prediction.json")).unwrap()).unwrap();
+    let role: Vec<(String, bool)> = p["terms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| (t["term"].as_str().unwrap().to_string(), t["calibrated"].as_bool().unwrap()))
+        .collect();
+    assert!(role.contains(&("F:dcb01".into(), true)) && role.contains(&("F:dcb03".into(), false)), "{role:?}");
+    assert!(pred.join("predict-dcb03-load.png").exists());
+    // The calibrated values are the calibration's.
+    let g = result["parameters"]["law.g_ic"]["value"].as_f64().unwrap();
+    assert_eq!(p["parameters"]["law.g_ic"].as_f64().unwrap(), g);
+
+    // Leaving out an unknown specimen, or all of them, says what is wrong.
+    let r = czid(&["identify", "examples/hartlen-dcb/joint.toml", "--leave-out", "dcb09", "--out", "unused"]);
+    assert!(!r.status.success() && stderr(&r).contains("no experiment is named `dcb09`"), "{}", stderr(&r));
+    assert!(stderr(&r).contains("dcb01, dcb02, dcb03"), "{}", stderr(&r));
+    let r =
+        czid(&["identify", "examples/hartlen-dcb/joint.toml", "--leave-out", "dcb01,dcb02,dcb03", "--out", "unused"]);
+    assert!(!r.status.success() && stderr(&r).contains("every experiment would be left out"), "{}", stderr(&r));
+    // A result file without the problem's parameters is refused by name.
+    let bogus = cal.join("bogus.json");
+    std::fs::write(&bogus, r#"{"parameters": {}}"#).unwrap();
+    let r = czid(&["predict", "examples/hartlen-dcb/joint.toml", "--from", bogus.to_str().unwrap(), "--out", "unused"]);
+    assert!(
+        !r.status.success() && stderr(&r).contains("holds no value for the parameter `law.strength_n`"),
+        "{}",
+        stderr(&r)
+    );
+    std::fs::remove_dir_all(&cal).ok();
+    std::fs::remove_dir_all(&pred).ok();
+    assert!(!Path::new("unused").exists());
+}

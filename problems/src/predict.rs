@@ -43,43 +43,64 @@ pub struct Prediction {
     pub failures: Vec<String>,
 }
 
-/// Runs every experiment of `problem` at the parameters of the calibration result `from` (a
-/// `result.json` of `czid identify`), writes `prediction.json` and the fits (`predict-*.csv`,
-/// plots) to `out`.
-pub fn predict(problem: &LoadedProblem, from: &Path, out: &OutputDir) -> Result<Prediction> {
-    let shown = from.display().to_string();
-    let text =
-        std::fs::read_to_string(from).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
-    let result: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| CzError::config(&shown, format!("not a result.json: {e}")))?;
-    let id = problem.identification()?;
-    let mut x = Vec::new();
-    let mut parameters = BTreeMap::new();
-    for p in id.space().parameters() {
-        let v = result["parameters"][&p.path]["value"].as_f64().ok_or_else(|| {
-            CzError::config(
-                &shown,
-                format!("holds no value for the parameter `{}` of {}", p.path, problem.path.display()),
-            )
-        })?;
-        x.push(v);
-        parameters.insert(p.path.clone(), v);
+/// The values a calibration identified, read from its `result.json` for the parameters of a
+/// problem file.
+#[derive(Clone, Debug)]
+pub struct Calibration {
+    /// The result file.
+    pub from: String,
+    /// Physical values in the order of the problem's parameters.
+    pub x: Vec<f64>,
+    /// The same by parameter path.
+    pub parameters: BTreeMap<String, f64>,
+    /// Terms the calibration fitted (e.g. `F:enf04`).
+    pub fitted: Vec<String>,
+}
+
+impl Calibration {
+    /// Reads `from` (a `result.json` of `czid identify`); every parameter of `problem` must be
+    /// in it.
+    pub fn read(problem: &LoadedProblem, from: &Path) -> Result<Self> {
+        let shown = from.display().to_string();
+        let text =
+            std::fs::read_to_string(from).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
+        let result: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| CzError::config(&shown, format!("not a result.json: {e}")))?;
+        let mut x = Vec::new();
+        let mut parameters = BTreeMap::new();
+        for p in &problem.file.parameter {
+            let v = result["parameters"][&p.path]["value"].as_f64().ok_or_else(|| {
+                CzError::config(
+                    &shown,
+                    format!("holds no value for the parameter `{}` of {}", p.path, problem.path.display()),
+                )
+            })?;
+            x.push(v);
+            parameters.insert(p.path.clone(), v);
+        }
+        let fitted = result["rms_error"]
+            .as_object()
+            .or_else(|| result["misfit"].as_object())
+            .map(|m| m.keys().cloned().collect())
+            .unwrap_or_default();
+        Ok(Calibration { from: shown, x, parameters, fitted })
     }
-    let calibrated: Vec<String> = result["rms_error"]
-        .as_object()
-        .or_else(|| result["misfit"].as_object())
-        .map(|m| m.keys().cloned().collect())
-        .unwrap_or_default();
-    let outcome = id.simulate(&x)?;
+}
+
+/// Runs every experiment of `problem` at the values of `calibration`, writes `prediction.json`
+/// and the fits (`predict-*.csv`, plots) to `out`.
+pub fn predict(problem: &LoadedProblem, calibration: &Calibration, out: &OutputDir) -> Result<Prediction> {
+    let id = problem.identification()?;
+    let outcome = id.simulate(&calibration.x)?;
     let terms = id
         .term_errors(&outcome)?
         .into_iter()
-        .map(|(term, error)| PredictedTerm { calibrated: calibrated.contains(&term), term, error })
+        .map(|(term, error)| PredictedTerm { calibrated: calibration.fitted.contains(&term), term, error })
         .collect();
     let prediction = Prediction {
         problem: problem.path.display().to_string(),
-        from: shown,
-        parameters,
+        from: calibration.from.clone(),
+        parameters: calibration.parameters.clone(),
         terms,
         failures: outcome.failures.clone(),
     };
