@@ -3,6 +3,9 @@
 //! * `dcb_paper_table3`: Shi & Zhang's DCB, 0.1 mm interface elements, ST-CZM Table 3, to the
 //!   default final opening (crack 60 % of the way to the end by beam theory).
 //! * `dcb_hartlen_30mm`: Hartlen's DCB-01 to 30 mm opening, bilinear law (G_Ic = 0.8 N/mm).
+//! * `enf_hartlen03_identified`: Hartlen's ENF-03 as `examples/hartlen-enf/enf03.toml` runs it
+//!   (0.25 mm interface elements, to the end of the test), at the law and modulus identified from
+//!   it; solved on the whole mesh (the contact on the cracked faces keeps it off the window).
 //!
 //! * `dcb_2d_paper_10mm`: the same DCB on the continuum model (`dcb_2d`, 0.1 mm interface
 //!   elements, 4 Gauss points each, band LU) to 10 mm opening: the mesh its convergence check
@@ -17,6 +20,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use czid_core::ForwardModel;
 use czid_models::dcb::Dcb;
 use czid_models::dcb_2d::Dcb2d;
+use czid_models::enf::Enf;
 use czid_models::laws::{Bilinear, StCzm};
 
 fn forward(c: &mut Criterion) {
@@ -28,6 +32,12 @@ fn forward(c: &mut Criterion) {
     let hartlen = Dcb::hartlen_dcb01();
     let law = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
     g.bench_function("dcb_hartlen_30mm", |b| b.iter(|| hartlen.simulate(&law).unwrap()));
+    let mut enf = Enf::hartlen_enf03();
+    enf.mesh.interface_element = 0.25;
+    enf.material.e11 = 34_134.8;
+    enf.control.max_displacement = Some(5.58);
+    let mode_two = Bilinear::bk(1e5, 30.0, 28.713, 0.8, 3.3351, 2.0).unwrap();
+    g.bench_function("enf_hartlen03_identified", |b| b.iter(|| enf.simulate(&mode_two).unwrap()));
     g.finish();
     let mut slow = c.benchmark_group("forward_continuum");
     slow.sample_size(10);
