@@ -27,6 +27,8 @@ pub mod quick_start {}
 pub mod paper_dcb {}
 #[doc = include_str!("src/real_dcb.md")]
 pub mod real_dcb {}
+#[doc = include_str!("src/mixed_mode.md")]
+pub mod mixed_mode {}
 #[doc = include_str!("src/diagnose.md")]
 pub mod diagnose {}
 #[doc = include_str!("src/diagnose_beam.md")]
