@@ -33,6 +33,7 @@ fn every_bundled_problem_file_loads() {
         "examples/hartlen-enf/joint.toml",
         "examples/hartlen-enf/enf04-toe-model.toml",
         "examples/hartlen-joint/dcb-enf.toml",
+        "examples/hartlen-joint/dcb-enf-stczm.toml",
         "examples/frp-pull/problem.toml",
     ] {
         let p = czid_problems::problem_file::LoadedProblem::read(&root.join(file))
