@@ -201,6 +201,11 @@ impl ForwardModel for Enf {
         Enf::validate(self)
     }
 
+    /// The ENF rule: the first peak, the unstable jump, the rise with the crack at the nose.
+    fn regimes(&self) -> &'static dyn czid_core::RegimeRule {
+        &crate::enf_regimes::EnfRegimes
+    }
+
     fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
         // The ENF model has no large-rotation option (it refuses `effects.large_rotation`).
         crate::effects::Effects::declarations(false)

@@ -259,6 +259,11 @@ impl ForwardModel for Enf2d {
         Enf2d::validate(self)
     }
 
+    /// The ENF rule: the first peak, the unstable jump, the rise with the crack at the nose.
+    fn regimes(&self) -> &'static dyn czid_core::RegimeRule {
+        &crate::enf_regimes::EnfRegimes
+    }
+
     fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
         ContinuumEffects::declarations(false)
     }

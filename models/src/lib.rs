@@ -11,6 +11,7 @@ pub mod effects;
 pub mod enf;
 pub mod enf_2d;
 pub mod enf_reduction;
+pub mod enf_regimes;
 pub mod fe;
 pub mod frp;
 pub mod laws;
