@@ -357,11 +357,11 @@ fn run_predict(problem: &Path, from: &Path, sets: &[(String, String)], out: &Out
     for (path, v) in &p.parameters {
         println!("  {path:<28} = {v:>12.6e}");
     }
-    println!("  {:<24} {:>12} {:>18}  role", "term", "rms error", "% of the test's peak");
+    println!("  {:<24} {:>13}  {:>8}  role", "term", "rms error", "% peak");
     for t in &p.terms {
         let role = if t.calibrated { "calibrated" } else { "held out" };
         println!(
-            "  {:<24} {:>9.4} {:<3}{:>17.2} %  {role}",
+            "  {:<24} {:>9.4} {:<3}  {:>6.2} %  {role}",
             t.term, t.error.value, t.error.unit, t.error.percent_of_peak
         );
     }
