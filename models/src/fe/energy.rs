@@ -161,18 +161,12 @@ pub(crate) fn path_work(
     w
 }
 
-/// Recoverable energy of the interface points (N·mm) in the committed `states` at `gaps`.
-pub fn interface_stored(
-    points: &[InterfacePoint],
-    law: &dyn CohesiveLaw,
-    states: &[LawState],
-    trial: &[LawEval],
-    gaps: &[Gap],
-) -> f64 {
+/// Recoverable energy of the interface points (N·mm) in the states of the evaluations `trial` at `gaps`.
+pub fn interface_stored(points: &[InterfacePoint], law: &dyn CohesiveLaw, trial: &[LawEval], gaps: &[Gap]) -> f64 {
     let mut e = 0.0;
     for (ip, p) in points.iter().enumerate() {
         let psi = match p.kind {
-            PointKind::Cohesive => law.stored_energy(&gaps[ip], &states[ip]),
+            PointKind::Cohesive => law.stored_energy(&gaps[ip], &trial[ip].state),
             // Contact is a linear penalty: ½ T·g.
             PointKind::Contact => 0.5 * trial[ip].traction.dot(&gaps[ip]),
         };

@@ -170,8 +170,6 @@ struct WholeMesh<'a> {
     cur: State,
     prev_q: Vec<f64>,
     trial: Vec<f64>,
-    /// Law states before the last commit (segments: the work is integrated along the gap path).
-    before: Vec<LawState>,
     ledger: Ledger,
     stats: RunStats,
     rows: Vec<StepRow>,
@@ -237,7 +235,6 @@ impl<'a> WholeMesh<'a> {
             cur: State { q: vec![0.0; n], states: vec![init; np], reaction: 0.0 },
             prev_q: vec![0.0; n],
             trial: vec![0.0; n],
-            before: Vec::new(),
             ledger: Ledger::new(np),
             stats: RunStats { window_fallback: fallback, ..Default::default() },
             rows: vec![StepRow {
@@ -353,16 +350,19 @@ impl<'a> WholeMesh<'a> {
                 c.overshoots += 1;
                 self.stats.cuts += 1;
             }
-            Ok(_) if !self.dissipates(lam, tau_try) => {
-                // The constraint measures released energy by the secant rule, exact for a
-                // linear-elastic unloading; a non-linear elastic response (contact on the cracked
-                // faces of an ENF) meets it on a branch that dissipates nothing, and unloading
-                // along it describes no test. Jump over the unstable stretch instead.
-                self.stats.cuts += 1;
-                return self.jump_over(c);
-            }
             Ok(it) => {
-                self.commit(lam, true);
+                // Weigh the step before accepting it: the constraint measures released energy by
+                // the secant rule, exact for a linear-elastic unloading; a non-linear elastic
+                // response (contact on the cracked faces of an ENF) meets it on a branch that
+                // dissipates nothing, and unloading along it describes no test. Such a step is
+                // refused and the unstable stretch jumped over instead.
+                let mut ledger = self.ledger.clone();
+                let energies = self.ledger_to_trial(&mut ledger, lam);
+                if energies.0 - self.last_diss <= 0.01 * tau_try {
+                    self.stats.cuts += 1;
+                    return self.jump_over(c);
+                }
+                self.accept(lam, true, ledger, energies);
                 self.stats.dissipation_steps += 1;
                 c.last = Some((lam - l0, tau_try));
                 let dc = (self.cur.q[ic] - c0).abs();
@@ -396,33 +396,6 @@ impl<'a> WholeMesh<'a> {
         Ok(())
     }
 
-    /// Whether accepting the trial solution (with load `reaction`) would dissipate a fair share
-    /// (1 %) of the prescribed `tau`: the same ledger update as [`WholeMesh::commit`], on a copy.
-    fn dissipates(&self, reaction: f64, tau: f64) -> bool {
-        let (p, law, ic) = (self.p, self.law, self.p.control);
-        let (t, g) = (&self.nw.asm.trial, &self.nw.asm.gaps);
-        let mut ledger = self.ledger.clone();
-        let dc = self.trial[ic] - self.cur.q[ic];
-        if self.segments {
-            ledger.commit_along(
-                &p.points,
-                law,
-                &self.cur.states,
-                t,
-                g,
-                dc,
-                self.cur.reaction,
-                reaction,
-                self.mode_one.as_ref(),
-            );
-        } else {
-            ledger.commit(&p.points, t, g, dc, self.cur.reaction, reaction);
-        }
-        let states: Vec<LawState> = t.iter().map(|ev| ev.state).collect();
-        let dissipated = ledger.interface_work - energy::interface_stored(&p.points, law, &states, t, g);
-        dissipated - self.last_diss > 0.01 * tau
-    }
-
     /// Last resort when the dissipation constraint cannot be met: jump over the unstable stretch
     /// under displacement control (the states recorded are still equilibria; the skipped part is
     /// not).
@@ -451,30 +424,41 @@ impl<'a> WholeMesh<'a> {
         Err(self.fail(msg))
     }
 
+    /// Brings `ledger` from the committed state to the trial solution with load `reaction` and
+    /// returns the interface's energies there: dissipated (the work done on it less what it
+    /// stores) and stored, point by point. The committed state is not touched, so a trial can be
+    /// weighed before it is accepted.
+    fn ledger_to_trial(&self, ledger: &mut Ledger, reaction: f64) -> (f64, f64) {
+        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let (t, g) = (&self.nw.asm.trial, &self.nw.asm.gaps);
+        let (dc, r_old) = (self.trial[ic] - self.cur.q[ic], self.cur.reaction);
+        if self.segments {
+            ledger.commit_along(&p.points, law, &self.cur.states, t, g, dc, r_old, reaction, self.mode_one.as_ref());
+        } else {
+            ledger.commit(&p.points, t, g, dc, r_old, reaction);
+        }
+        let stored = energy::interface_stored(&p.points, law, t, g);
+        (ledger.interface_work - stored, stored)
+    }
+
     /// Accepts the trial solution with `reaction` as its load: law states, energy ledger and
     /// front track move on; with `record`, a row is written.
     fn commit(&mut self, reaction: f64, record: bool) {
+        let mut ledger = std::mem::take(&mut self.ledger);
+        let energies = self.ledger_to_trial(&mut ledger, reaction);
+        self.accept(reaction, record, ledger, energies);
+    }
+
+    /// [`WholeMesh::commit`] with the ledger already brought to the trial solution.
+    fn accept(&mut self, reaction: f64, record: bool, ledger: Ledger, (dissipated, stored): (f64, f64)) {
         let (p, law, ic) = (self.p, self.law, self.p.control);
-        let c_old = self.cur.q[ic];
-        let r_old = self.cur.reaction;
+        self.ledger = ledger;
         self.prev_q.copy_from_slice(&self.cur.q);
         self.cur.q.copy_from_slice(&self.trial);
-        if self.segments {
-            self.before.clone_from(&self.cur.states);
-        }
         for (st, ev) in self.cur.states.iter_mut().zip(&self.nw.asm.trial) {
             *st = ev.state;
         }
         self.cur.reaction = reaction;
-        let (t, g) = (&self.nw.asm.trial, &self.nw.asm.gaps);
-        if self.segments {
-            let dc = self.cur.q[ic] - c_old;
-            self.ledger.commit_along(&p.points, law, &self.before, t, g, dc, r_old, reaction, self.mode_one.as_ref());
-        } else {
-            self.ledger.commit(&p.points, t, g, self.cur.q[ic] - c_old, r_old, reaction);
-        }
-        let stored = energy::interface_stored(&p.points, law, &self.cur.states, t, g);
-        let dissipated = self.ledger.interface_work - stored;
         // With segments the recoverable energy is integrated like the forces (the dissipation
         // stays point by point, where the work is integrated).
         let stored = if self.segments {
