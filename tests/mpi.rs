@@ -9,17 +9,23 @@ use std::process::{Command, Output};
 
 const PROBLEM: &str = "examples/paper-dcb/problem.toml";
 
-fn run(ranks: Option<usize>, out: &Path, extra: &[&str]) -> Output {
+/// Runs czid with `args`, on `ranks` MPI ranks through `mpiexec` or as one plain process.
+fn czid<S: AsRef<std::ffi::OsStr>>(ranks: Option<usize>, args: &[S]) -> Output {
     let bin = env!("CARGO_BIN_EXE_czid");
-    let mut args: Vec<String> = Vec::new();
-    if let Some(n) = ranks {
-        args.extend(["-n".to_string(), n.to_string(), bin.to_string()]);
-    }
+    let mut cmd = match ranks {
+        Some(n) => {
+            let mut c = Command::new("mpiexec");
+            c.args(["-n", &n.to_string(), bin]);
+            c
+        }
+        None => Command::new(bin),
+    };
+    cmd.args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+}
+
+fn run(ranks: Option<usize>, out: &Path, extra: &[&str]) -> Output {
     let base = ["identify", PROBLEM, "--optimizer", "miga", "--budget", "400", "--out", out.to_str().unwrap()];
-    args.extend(base.iter().map(|s| s.to_string()));
-    args.extend(extra.iter().map(|s| s.to_string()));
-    let program = if ranks.is_some() { "mpiexec" } else { bin };
-    Command::new(program).args(&args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+    czid(ranks, &[&base[..], extra].concat())
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -72,8 +78,7 @@ fn two_ranks_give_the_serial_result_and_a_killed_run_resumes_to_it() {
 }
 
 fn compare(ranks: Option<usize>, out: &Path) -> Output {
-    let bin = env!("CARGO_BIN_EXE_czid");
-    let base = [
+    let args = [
         "compare",
         PROBLEM,
         "--optimizers",
@@ -85,15 +90,7 @@ fn compare(ranks: Option<usize>, out: &Path) -> Output {
         "--out",
         out.to_str().unwrap(),
     ];
-    let mut cmd = match ranks {
-        Some(n) => {
-            let mut c = Command::new("mpiexec");
-            c.args(["-n", &n.to_string(), bin]);
-            c
-        }
-        None => Command::new(bin),
-    };
-    cmd.args(base).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+    czid(ranks, &args)
 }
 
 /// `summary.csv` without its wall-time column.
@@ -120,26 +117,14 @@ fn compare_on_two_ranks_gives_the_serial_table() {
 
 #[test]
 fn gap_bench_cases_spread_over_two_ranks_give_the_serial_cases() {
-    let bin = env!("CARGO_BIN_EXE_czid");
     let args = |out: &Path| {
         ["gap-bench", "--cases", "1", "--nulls", "1", "--effects", "machine_compliance", "--out", out.to_str().unwrap()]
             .map(str::to_string)
     };
     let serial = scratch("bench-serial");
-    assert!(Command::new(bin)
-        .args(args(&serial))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
-        .status
-        .success());
+    assert!(czid(None, &args(&serial)).status.success());
     let two = scratch("bench-two");
-    let o = Command::new("mpiexec")
-        .args(["-n", "2", bin])
-        .args(args(&two))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
+    let o = czid(Some(2), &args(&two));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stdout).contains("cases on 2 ranks: rank 0: 1, rank 1: 1"));
     for name in ["case-dcb-seed1-0000-machine_compliance.json", "case-dcb-seed1-0001-none.json"] {
@@ -158,7 +143,6 @@ fn gap_bench_cases_spread_over_two_ranks_give_the_serial_cases() {
 
 #[test]
 fn diagnose_refits_spread_over_two_ranks_give_the_serial_diagnosis() {
-    let bin = env!("CARGO_BIN_EXE_czid");
     // Four cheap candidates, all refitted; the cause's refit is judged again with the model-form
     // floor re-estimated, and the held-out late stage is predicted (about 5 s serial).
     let args = |out: &Path| {
@@ -179,15 +163,10 @@ fn diagnose_refits_spread_over_two_ranks_give_the_serial_diagnosis() {
         .map(str::to_string)
     };
     let serial = scratch("diagnose-serial");
-    let o = Command::new(bin).args(args(&serial)).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap();
+    let o = czid(None, &args(&serial));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let two = scratch("diagnose-two");
-    let o = Command::new("mpiexec")
-        .args(["-n", "2", bin])
-        .args(args(&two))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
+    let o = czid(Some(2), &args(&two));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // Both ranks refitted: "refits on 2 ranks: rank 0: a, rank 1: b" with a + b = 4, a, b > 0.
     let stdout = String::from_utf8_lossy(&o.stdout);
