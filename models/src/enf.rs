@@ -16,8 +16,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::beamtest::{self, ControlSettings, Material, MeshSettings, RowScale};
 use crate::effects::Effects;
-use crate::fe::mesh::{graded, NONE};
-use crate::fe::{self, FeProblem, InterfacePoint, Layer, Mesh, PathSettings, PointKind, Section, Spring};
+use crate::fe::mesh::graded;
+use crate::fe::{self, FeProblem, Layer, Mesh, PathSettings, Section};
 
 /// ENF configuration. All lengths in mm, moduli in MPa.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -153,27 +153,8 @@ impl Enf {
         let lo = Layer { section: s, y: 0.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
         let up = Layer { section: s, y: 1.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
         let mesh = Mesh::new(x, vec![lo, up], crate::measurement::extra_unknowns(fx.machine_compliance, false))?;
-        let mut points = Vec::with_capacity(nn + 1);
-        let mut springs = Vec::new();
-        for i in 0..nn {
-            let left = if i > 0 { 0.5 * (mesh.x[i] - mesh.x[i - 1]) } else { 0.0 };
-            let right = if i + 1 < nn { 0.5 * (mesh.x[i + 1] - mesh.x[i]) } else { 0.0 };
-            let pt = |area: f64, kind| InterfacePoint { node: i, upper: 1, lower: Some(0), area, factor: 1.0, kind };
-            if i < tip {
-                points.push(pt(self.width * (left + right), PointKind::Contact));
-            } else if i == tip {
-                points.push(pt(self.width * left, PointKind::Contact));
-                points.push(pt(self.width * right, PointKind::Cohesive));
-            } else {
-                points.push(pt(self.width * (left + right), PointKind::Cohesive));
-            }
-            if fx.root_compliance > 0.0 && i >= tip {
-                let area = self.width * (if i == tip { right } else { left + right });
-                for layer in 0..2 {
-                    springs.push(Spring { i: mesh.dofs(layer, i)[3], j: NONE, k: area / fx.root_compliance, ci: 1.0 });
-                }
-            }
-        }
+        let (points, mut springs) =
+            beamtest::cracked_arms_interface(&mesh, tip, nn - 1, self.width, fx.root_compliance);
         let fixed = vec![mesh.dofs(0, 0)[1], mesh.dofs(0, nn - 1)[1], mesh.dofs(0, nn - 1)[0]];
         let w_load = mesh.dofs(1, mid)[1];
         // The load nose pushes the upper arm down: recorded deflection and load are positive.

@@ -17,4 +17,5 @@ pub mod frp;
 pub mod laws;
 pub mod materials;
 pub mod measurement;
+pub mod mmb;
 pub mod registry;

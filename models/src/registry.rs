@@ -9,7 +9,7 @@ use czid_core::{CohesiveLaw, ForwardModel};
 /// `type` names of the bundled cohesive laws.
 pub const LAW_TYPES: &[&str] = &["st_czm", "bilinear", "exponential", "bridging", "lu_bond_slip"];
 /// `type` names of the bundled forward models.
-pub const MODEL_TYPES: &[&str] = &["dcb", "enf", "frp_pull", "frp_beam", "dcb_2d", "enf_2d"];
+pub const MODEL_TYPES: &[&str] = &["dcb", "enf", "frp_pull", "frp_beam", "dcb_2d", "enf_2d", "mmb"];
 
 /// Makes sure every bundled law and model can be read from a configuration file. Cheap; call it
 /// before deserialising laws or models in a program that does not otherwise use their types.
@@ -27,4 +27,5 @@ pub fn ensure_linked() {
     std::hint::black_box(<crate::frp::beam::FrpBeam as ForwardModel>::validate as fn(&_) -> _);
     std::hint::black_box(<crate::dcb_2d::Dcb2d as ForwardModel>::validate as fn(&_) -> _);
     std::hint::black_box(<crate::enf_2d::Enf2d as ForwardModel>::validate as fn(&_) -> _);
+    std::hint::black_box(<crate::mmb::Mmb as ForwardModel>::validate as fn(&_) -> _);
 }

@@ -15,6 +15,7 @@ fn models() -> Vec<Box<dyn ForwardModel>> {
         Box::new(FrpBeam::paper().unwrap()),
         Box::new(czid_models::dcb_2d::Dcb2d::hartlen_dcb01()),
         Box::new(czid_models::enf_2d::Enf2d::hartlen_enf03()),
+        Box::new(czid_models::mmb::Mmb::hartlen(50.0)),
     ]
 }
 

@@ -22,6 +22,9 @@ pub struct Ledger {
     pub external_work: f64,
     /// Work done on the interface points (recoverable + dissipated).
     pub interface_work: f64,
+    /// The part of `interface_work` done by the tangential tractions on the slips (the rest is
+    /// done by the normal tractions on the openings): the mode II share of the interface's work.
+    pub shear_work: f64,
     /// Last committed tractions and gaps of the interface points.
     tractions: Vec<Traction>,
     gaps: Vec<Gap>,
@@ -33,6 +36,7 @@ impl Ledger {
         Ledger {
             external_work: 0.0,
             interface_work: 0.0,
+            shear_work: 0.0,
             tractions: vec![Traction::zeros(); n],
             gaps: vec![Gap::zeros(); n],
         }
@@ -49,15 +53,17 @@ impl Ledger {
         r_new: f64,
     ) {
         self.external_work += 0.5 * (r_old + r_new) * dc;
-        let mut w = 0.0;
+        let (mut w, mut ws) = (0.0, 0.0);
         for (ip, p) in points.iter().enumerate() {
             let t = trial[ip].traction;
             let g = gaps[ip];
             w += p.area * p.factor * 0.5 * (t + self.tractions[ip]).dot(&(g - self.gaps[ip]));
+            ws += p.area * p.factor * 0.5 * (t[1] + self.tractions[ip][1]) * (g[1] - self.gaps[ip][1]);
             self.tractions[ip] = t;
             self.gaps[ip] = g;
         }
         self.interface_work += w;
+        self.shear_work += ws;
     }
 
     /// [`Ledger::commit`], with each cohesive point's work integrated along its straight gap path
@@ -78,19 +84,21 @@ impl Ledger {
         mode_one: Option<&ModeOne>,
     ) {
         self.external_work += 0.5 * (r_old + r_new) * dc;
-        let mut w = 0.0;
+        let (mut w, mut ws) = (0.0, 0.0);
         for (ip, p) in points.iter().enumerate() {
             let (t0, g0, t1, g1) = (self.tractions[ip], self.gaps[ip], trial[ip].traction, gaps[ip]);
-            let dw = if p.kind == PointKind::Cohesive && trial[ip].state != before[ip] {
-                path_work(law, &before[ip], (g0, t0), (g1, t1), &trial[ip].state, mode_one)
+            let (dw, dws) = if p.kind == PointKind::Cohesive && trial[ip].state != before[ip] {
+                path_work_split(law, &before[ip], (g0, t0), (g1, t1), &trial[ip].state, mode_one)
             } else {
-                0.5 * (t0 + t1).dot(&(g1 - g0))
+                (0.5 * (t0 + t1).dot(&(g1 - g0)), 0.5 * (t0[1] + t1[1]) * (g1[1] - g0[1]))
             };
             w += p.area * p.factor * dw;
+            ws += p.area * p.factor * dws;
             self.tractions[ip] = t1;
             self.gaps[ip] = g1;
         }
         self.interface_work += w;
+        self.shear_work += ws;
     }
 }
 
@@ -99,11 +107,24 @@ impl Ledger {
 pub(crate) fn path_work(
     law: &dyn CohesiveLaw,
     s0: &LawState,
+    g0t0: (Gap, Traction),
+    g1t1: (Gap, Traction),
+    after: &LawState,
+    mode_one: Option<&ModeOne>,
+) -> f64 {
+    path_work_split(law, s0, g0t0, g1t1, after, mode_one).0
+}
+
+/// [`path_work`] and the part of it done by the tangential traction on the slip, by the same
+/// rule (the total is summed exactly as [`path_work`] always did).
+pub(crate) fn path_work_split(
+    law: &dyn CohesiveLaw,
+    s0: &LawState,
     (g0, t0): (Gap, Traction),
     (g1, t1): (Gap, Traction),
     after: &LawState,
     mode_one: Option<&ModeOne>,
-) -> f64 {
+) -> (f64, f64) {
     let dg = g1 - g0;
     let at = |t: f64| g0 + dg * t;
     let traction = |t: f64| law.evaluate(&at(t), s0).traction;
@@ -147,7 +168,7 @@ pub(crate) fn path_work(
     }
     bp[n] = 1.0;
     bp[1..n].sort_by(f64::total_cmp);
-    let mut w = 0.0;
+    let (mut w, mut ws) = (0.0, 0.0);
     for k in 0..n {
         let (a, b) = (bp[k], bp[k + 1]);
         if b <= a {
@@ -156,9 +177,11 @@ pub(crate) fn path_work(
         let ta = if a == 0.0 { t0 } else { traction(a) };
         let tb = if b == 1.0 { t1 } else { traction(b) };
         let tm = traction(0.5 * (a + b));
-        w += (b - a) / 6.0 * (ta + tm * 4.0 + tb).dot(&dg);
+        let simpson = ta + tm * 4.0 + tb;
+        w += (b - a) / 6.0 * simpson.dot(&dg);
+        ws += (b - a) / 6.0 * simpson[1] * dg[1];
     }
-    w
+    (w, ws)
 }
 
 /// Recoverable energy of the interface points (N·mm) in the states of the evaluations `trial` at `gaps`.

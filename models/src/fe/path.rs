@@ -239,6 +239,7 @@ impl<'a> WholeMesh<'a> {
             stats: RunStats { window_fallback: fallback, ..Default::default() },
             rows: vec![StepRow {
                 crack: CrackMeasures { tip: s.crack_origin, ..Default::default() },
+                shear_work: Some(0.0),
                 ..Default::default()
             }],
             measures,
@@ -491,6 +492,7 @@ impl<'a> WholeMesh<'a> {
                 elastic_energy: structural + stored,
                 dissipated_energy: dissipated,
                 crack,
+                shear_work: Some(self.ledger.shear_work),
             });
         }
     }

@@ -45,6 +45,10 @@ pub struct StepRow {
     pub dissipated_energy: f64,
     /// Debonded length, process zone and tip along the cohesive points.
     pub crack: CrackMeasures,
+    /// Work done so far by the interface's tangential tractions on the slips (the mode II part of
+    /// the interface's work, recoverable energy included), when the solver tracks it: the
+    /// whole-mesh solver does; the window solver does not (`None`).
+    pub shear_work: Option<f64>,
 }
 
 /// Statistics of a run, for profiling and tests.

@@ -1189,6 +1189,7 @@ impl<'a, const D: usize> Solver<'a, D> {
             elastic_energy: self.elastic_energy(),
             dissipated_energy: dissipated,
             crack: self.crack(),
+            shear_work: None,
         }
     }
 
