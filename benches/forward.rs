@@ -7,6 +7,11 @@
 //!   (0.25 mm interface elements, to the end of the test), at the law and modulus identified from
 //!   it; solved on the whole mesh (the contact on the cracked faces keeps it off the window).
 //!
+//! * `mmb_hartlen_half_mode_two`: an MMB (ASTM D6671) of Hartlen's ENF specimen with the lever for
+//!   G_II/G = 0.5 (c = 43.72 mm), 0.2 mm interface elements, a B-K law, to 7 mm (about 9 mm of
+//!   crack growth): `examples/mixed-mode-synthetic/problem.toml`'s MMB at its truth; whole mesh (the
+//!   supports and the lever act away from the cracked end, and the cracked faces have contact).
+//!
 //! * `dcb_2d_paper_10mm`: the same DCB on the continuum model (`dcb_2d`, 0.1 mm interface
 //!   elements, 4 Gauss points each, band LU) to 10 mm opening: the mesh its convergence check
 //!   accepts (see the book's "Beam or continuum?" chapter).
@@ -22,6 +27,7 @@ use czid_models::dcb::Dcb;
 use czid_models::dcb_2d::Dcb2d;
 use czid_models::enf::Enf;
 use czid_models::laws::{Bilinear, StCzm};
+use czid_models::mmb::Mmb;
 
 fn forward(c: &mut Criterion) {
     let mut g = c.benchmark_group("forward");
@@ -38,6 +44,10 @@ fn forward(c: &mut Criterion) {
     enf.control.max_displacement = Some(5.58);
     let mode_two = Bilinear::bk(1e5, 30.0, 28.713, 0.8, 3.3351, 2.0).unwrap();
     g.bench_function("enf_hartlen03_identified", |b| b.iter(|| enf.simulate(&mode_two).unwrap()));
+    let mut mmb = Mmb::hartlen(43.722);
+    mmb.control.max_displacement = Some(7.0);
+    let mixed = Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).unwrap();
+    g.bench_function("mmb_hartlen_half_mode_two", |b| b.iter(|| mmb.simulate(&mixed).unwrap()));
     g.finish();
     let mut slow = c.benchmark_group("forward_continuum");
     slow.sample_size(10);
