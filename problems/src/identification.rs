@@ -9,7 +9,8 @@ use czid_core::{
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
+use std::borrow::Cow;
+use std::collections::{BTreeMap, BTreeSet};
 
 use crate::data::Experiment;
 
@@ -122,6 +123,8 @@ pub struct Runs {
     pub records: BTreeMap<String, Record>,
     /// Messages of runs that failed part way, `experiment: why`.
     pub failures: Vec<String>,
+    /// The experiments whose run failed part way.
+    pub failed: BTreeSet<String>,
 }
 
 /// Simulates the experiments `names` of `setup`, in parallel (each run is independent, so the
@@ -147,9 +150,12 @@ pub fn simulate_experiments(setup: &Setup, names: &[&str]) -> Result<Runs> {
             }
         })
         .collect();
-    let mut out = Runs { records: BTreeMap::new(), failures: Vec::new() };
+    let mut out = Runs { records: BTreeMap::new(), failures: Vec::new(), failed: BTreeSet::new() };
     for (name, run) in names.iter().zip(runs) {
         let (record, failure) = run?;
+        if failure.is_some() {
+            out.failed.insert(name.to_string());
+        }
         out.failures.extend(failure);
         out.records.insert(name.to_string(), record);
     }
@@ -165,6 +171,52 @@ pub struct Outcome {
     pub records: BTreeMap<String, Record>,
     /// Messages of runs that failed part way.
     pub failures: Vec<String>,
+    /// The experiments whose run failed part way (their records end where the run stopped).
+    pub failed: BTreeSet<String>,
+}
+
+impl Outcome {
+    /// The record `experiment` is scored on: its own, or for a run that failed part way the one
+    /// [`scored_as_broken`] makes of it.
+    pub fn scored(&self, experiment: &str) -> Cow<'_, Record> {
+        let record = &self.records[experiment];
+        if self.failed.contains(experiment) {
+            Cow::Owned(scored_as_broken(record))
+        } else {
+            Cow::Borrowed(record)
+        }
+    }
+}
+
+/// How a run that failed part way is scored: as if the specimen had broken just beyond the last
+/// state the run reached (every column but the displacement drops to zero there), so that each
+/// reading it did not reach costs its full value. Holding the last state instead, as a run that
+/// simply ends before the data does is scored, made a failing run cheaper than a complete one
+/// wherever the test's load stays near the last value reached (an ENF after its unstable jump):
+/// an optimizer then goes where runs fail. A record without a displacement column is returned
+/// as it is.
+///
+/// ```
+/// use czid_core::{columns, Record};
+/// use czid_problems::identification::scored_as_broken;
+///
+/// let mut run = Record::new(&[(columns::DISPLACEMENT, "mm"), (columns::LOAD, "N")]);
+/// run.push(&[0.0, 0.0]);
+/// run.push(&[1.0, 50.0]); // the run failed here
+/// let scored = scored_as_broken(&run);
+/// let load = scored.curve(columns::DISPLACEMENT, columns::LOAD).unwrap();
+/// // Readings before the failure are interpolated as before; beyond it the run predicts nothing.
+/// assert_eq!(load.sample(&[0.5, 2.0]), vec![25.0, 0.0]);
+/// ```
+pub fn scored_as_broken(record: &Record) -> Record {
+    let mut out = record.clone();
+    let Ok(x) = record.column(columns::DISPLACEMENT) else { return out };
+    let Some(&last) = x.last() else { return out };
+    let beyond = last + (1e-9 * last.abs()).max(1e-12);
+    let row: Vec<f64> =
+        record.columns().iter().map(|c| if c.name == columns::DISPLACEMENT { beyond } else { 0.0 }).collect();
+    out.push(&row);
+    out
 }
 
 /// An identification problem over the unit cube.
@@ -250,7 +302,7 @@ impl Identification {
         let parts: Vec<Vec<f64>> = self
             .fits
             .iter()
-            .map(|fit| Ok(fit.objective.evaluate(&outcome.records[&fit.name])?.terms))
+            .map(|fit| Ok(fit.objective.evaluate(&outcome.scored(&fit.name))?.terms))
             .collect::<Result<_>>()?;
         // One balance over every experiment's terms side by side.
         let all: Vec<f64> = parts.iter().flatten().copied().collect();
@@ -295,34 +347,42 @@ impl Identification {
 
     /// Simulates every experiment at physical values `x` and evaluates the objective.
     ///
-    /// A run that fails part way is scored on its converged steps (the last value held), so the
-    /// optimizer sees a large but finite value; a run with fewer than two steps is an error.
+    /// A run that fails part way is scored on its converged steps and, beyond them, as a broken
+    /// specimen ([`scored_as_broken`]), so the optimizer sees a large but finite value; a run with
+    /// fewer than two steps is an error.
     pub fn simulate(&self, x: &[f64]) -> Result<Outcome> {
         let setup = self.configure(x)?;
         let kinds = self.term_kinds();
         let names: Vec<&str> = self.fits.iter().map(|f| f.name.as_str()).collect();
-        let Runs { records, failures } = simulate_experiments(&setup, &names)?;
+        let Runs { records, failures, failed } = simulate_experiments(&setup, &names)?;
+        let mut outcome = Outcome {
+            evaluation: Evaluation { value: 0.0, objectives: Vec::new(), residuals: Vec::new() },
+            records,
+            failures,
+            failed,
+        };
         let mut objectives = vec![0.0; kinds.len()];
         let mut residuals = Vec::new();
         let mut value = 0.0;
         for fit in &self.fits {
-            let record = &records[&fit.name];
-            let v = fit.objective.evaluate(record)?;
+            let record = outcome.scored(&fit.name);
+            let v = fit.objective.evaluate(&record)?;
             for ((kind, part), term) in fit.kinds.iter().zip(&v.terms).zip(fit.objective.terms()) {
                 let slot = kinds.iter().position(|k| k == kind).expect("kinds cover every term");
                 objectives[slot] += term.weight * part;
             }
             value += v.value;
-            residuals.extend(fit.objective.residuals(record)?);
+            residuals.extend(fit.objective.residuals(&record)?);
         }
-        Ok(Outcome { evaluation: Evaluation { value, objectives, residuals }, records, failures })
+        outcome.evaluation = Evaluation { value, objectives, residuals };
+        Ok(outcome)
     }
 
     /// Unweighted `||φ||²` per experiment and term, e.g. `("F:dcb", 1.2e-4)`.
     pub fn term_values(&self, outcome: &Outcome) -> Result<Vec<(String, f64)>> {
         let mut out = Vec::new();
         for fit in &self.fits {
-            let v = fit.objective.evaluate(&outcome.records[&fit.name])?;
+            let v = fit.objective.evaluate(&outcome.scored(&fit.name))?;
             out.extend(fit.objective.terms().iter().zip(v.terms).map(|(t, s)| (t.name.clone(), s)));
         }
         Ok(out)
@@ -334,7 +394,7 @@ impl Identification {
     pub fn term_errors(&self, outcome: &Outcome) -> Result<Vec<(String, RmsError)>> {
         let mut out = Vec::new();
         for fit in &self.fits {
-            let v = fit.objective.evaluate(&outcome.records[&fit.name])?;
+            let v = fit.objective.evaluate(&outcome.scored(&fit.name))?;
             for ((term, kind), misfit) in fit.objective.terms().iter().zip(&fit.kinds).zip(v.terms) {
                 let y = term.data.y();
                 let mean_square = y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64;

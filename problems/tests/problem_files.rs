@@ -48,6 +48,9 @@ impl CohesiveLaw for Spring {
 struct Patch {
     area: f64,
     max_opening: f64,
+    /// A law this stiff or stiffer makes the run fail half way (MPa/mm; none by default).
+    #[serde(default)]
+    fails_from: Option<f64>,
 }
 
 #[typetag::serde(name = "toy_patch")]
@@ -67,6 +70,10 @@ impl ForwardModel for Patch {
             let e = law.evaluate(&Gap::new(d, 0.0), &state);
             state = e.state;
             r.push(&[d, self.area * e.traction[0], d]);
+            if i == 10 && self.fails_from.is_some_and(|k| law.initial_stiffness()[0] >= k) {
+                let error = CzError::Simulation("no convergence half way (a test model's failure)".into());
+                return Err(SimulationFailure { error, partial: r });
+            }
         }
         Ok(r)
     }
@@ -370,4 +377,33 @@ fn a_budget_that_ends_before_convergence_is_said_and_qualifies_the_verdicts() {
     let res = run("lm-long", "levenberg-marquardt", 500);
     assert!(res.evaluations < 500 && res.converged, "{} evaluations", res.evaluations);
     assert!(!res.parameters["law.stiffness"].verdict.contains("provisional"));
+}
+
+/// A run that fails part way is scored as a broken specimen beyond its last state: each reading
+/// it did not reach costs its full value (the data's load and debonded length against zero), not
+/// the misfit of its last state held.
+#[test]
+fn a_run_that_fails_part_way_costs_every_reading_it_did_not_reach() {
+    let text = problem_text("").replace("max_opening = 1.0", "max_opening = 1.0\nfails_from = 90.0");
+    let dir = setup_dir("fails", &text);
+    let p = read(&dir).unwrap();
+    let id = p.identification().unwrap();
+    let w: Vec<f64> = id.weights().iter().map(|(_, w)| *w).collect();
+    let outcome = id.simulate(&[95.0]).unwrap();
+    assert_eq!(outcome.failures.len(), 1, "{:?}", outcome.failures);
+    assert_eq!(outcome.records["patch"].rows(), 11, "the record keeps the states the run reached");
+    // By hand: readings at d = 0, 0.1, …, 1 of P = 160 d and L = d; the run reached d = 0.5 with
+    // P = 2 × 95 d and L = d.
+    let ds: Vec<f64> = (0..=10).map(|i| i as f64 / 10.0).collect();
+    let norm = |f: &dyn Fn(f64) -> f64| ds.iter().map(|&d| f(d).powi(2)).sum::<f64>();
+    let load = |d: f64| if d <= 0.5 + 1e-12 { 160.0 * d - 190.0 * d } else { 160.0 * d };
+    let length = |d: f64| if d <= 0.5 + 1e-12 { 0.0 } else { d };
+    let expected = w[0] * norm(&load) / norm(&|d| 160.0 * d) + w[1] * norm(&length) / norm(&|d| d);
+    let f = outcome.evaluation.value;
+    assert!((f / expected - 1.0).abs() < 1e-9, "{f} vs {expected}");
+    // Holding the last state would have cost far less: the failing run must not look better
+    // than a complete one at the same distance from the truth (stiffness 65, below the failure).
+    let complete = id.simulate(&[65.0]).unwrap();
+    assert!(complete.failures.is_empty());
+    assert!(f > 10.0 * complete.evaluation.value, "{f} vs {}", complete.evaluation.value);
 }

@@ -58,7 +58,7 @@ impl Misfit {
     /// The misfit of `setup` on `gauge`: its experiments simulated through the path every
     /// identification uses ([`simulate_experiments`]), compared reading by reading.
     pub fn of(gauge: &Gauge, setup: &Setup) -> Result<Misfit> {
-        let Runs { records, failures } = simulate_experiments(setup, &gauge.experiments())?;
+        let Runs { records, failures, .. } = simulate_experiments(setup, &gauge.experiments())?;
         Ok(Misfit { r: gauge.residuals(&records)?, records, failures })
     }
 
