@@ -356,6 +356,35 @@ pub fn cracked_arms_interface(
     (points, springs)
 }
 
+/// Checks what the split beams on two supports (ENF, MMB) share: no large rotations, and the
+/// crack front `a0 + effects.crack_length_offset` inside the first half-span.
+pub fn check_split_beam(
+    owner: &str,
+    model: &str,
+    effects: &crate::effects::Effects,
+    a0: f64,
+    half_span: f64,
+) -> Result<()> {
+    if effects.large_rotation {
+        return Err(CzError::invalid(
+            owner,
+            "effects.large_rotation",
+            1.0,
+            format!("is not supported by the {model} model"),
+        ));
+    }
+    let a = a0 + effects.crack_length_offset;
+    if !(a > 0.0 && a < half_span) {
+        return Err(CzError::invalid(
+            owner,
+            "a0",
+            a0,
+            format!("the crack front a0 + effects.crack_length_offset = {a} must lie in (0, half_span)"),
+        ));
+    }
+    Ok(())
+}
+
 /// Checks a length is positive.
 pub fn positive(owner: &str, name: &str, v: f64) -> Result<()> {
     require_positive(owner, name, v)

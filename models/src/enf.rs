@@ -88,19 +88,7 @@ impl Enf {
         self.mesh.validate(OWNER)?;
         self.control.validate(OWNER)?;
         self.effects.validate(OWNER)?;
-        if self.effects.large_rotation {
-            return Err(CzError::invalid(OWNER, "effects.large_rotation", 1.0, "is not supported by the ENF model"));
-        }
-        let a = self.effective_crack_length();
-        if !(a > 0.0 && a < self.half_span) {
-            return Err(CzError::invalid(
-                OWNER,
-                "a0",
-                self.a0,
-                format!("the crack front a0 + effects.crack_length_offset = {a} must lie in (0, half_span)"),
-            ));
-        }
-        Ok(())
+        beamtest::check_split_beam(OWNER, "ENF", &self.effects, self.a0, self.half_span)
     }
 
     /// Crack length the mesh uses: `a0 + effects.crack_length_offset` (mm).

@@ -161,3 +161,17 @@ fn energy_balances_through_propagation() {
     assert!(*debonded > 5.0, "the crack grew");
     assert!(worst < 0.005, "energy balance {worst}");
 }
+
+#[test]
+fn bad_configurations_name_the_field() {
+    let law = TestBilinear::new(1e6, 30.0, 1.0);
+    let fails_on = |m: Mmb, field: &str| {
+        let err = m.simulate(&law).expect_err("must be refused").error.to_string();
+        assert!(err.contains(field), "{err}");
+    };
+    fails_on(Mmb::hartlen(-5.0), "lever");
+    fails_on(Mmb { a0: 60.0, ..Mmb::hartlen(40.0) }, "a0");
+    let mut m = Mmb::hartlen(40.0);
+    m.effects.large_rotation = true;
+    fails_on(m, "large_rotation");
+}
