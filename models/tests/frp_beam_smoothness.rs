@@ -10,9 +10,9 @@
 //!
 //! * **onset of local debonding**: the debonded length when the load first reaches 98 % of its
 //!   largest value (on the rising branch, just before the run jumps through the unstable IC
-//!   debonding; see `czid_core::events::OnsetOfDebonding`);
+//!   debonding; see `czid_core::event::OnsetOfDebonding`);
 //! * **end of the test**: the debonded length when the mid-span deflection first reaches the test's
-//!   last reading, here 26 mm (a debonding plateau of this model).
+//!   last reading, here 26 mm (a debonding plateau of this model; `czid_core::event::EndOfTest`).
 //!
 //! **The path.** The beam runs with `control.damage_tolerance = 1`: no step is repeated smaller
 //! because the law's damage departs from the extrapolated one, so the runs take the same 176 steps
@@ -35,7 +35,8 @@
 //! kinks of the interface and the fibres crossed within a step. The test asserts 8 % for the
 //! located front, and that the former measure fails that check where it jumps (55 %).
 
-use czid_core::columns;
+use czid_core::event::{EndOfTest, OnsetOfDebonding};
+use czid_core::{columns, Record, Response};
 use czid_models::fe::crack;
 use czid_models::frp::beam::{BeamRun, FrpBeam};
 use czid_models::laws::StCzm;
@@ -55,30 +56,21 @@ fn run(strength_t: f64, u_c_t: f64) -> BeamRun {
     run
 }
 
-/// `v` where `c` first reaches `level`, linearly interpolated between the two states around it.
-fn first_reaching(c: &[f64], level: f64, v: &[f64]) -> f64 {
-    let i = c.iter().position(|&x| x >= level).expect("the level is reached");
-    assert!(i > 0);
-    let t = (level - c[i - 1]) / (c[i] - c[i - 1]);
-    v[i - 1] + t * (v[i] - v[i - 1])
-}
-
-/// `[[onset, end] located, [onset, end] counted]` of a run.
+/// `[[onset, end] located, [onset, end] counted]` of a run, read by the event responses.
 fn events(run: &BeamRun) -> [[f64; 2]; 2] {
     let rec = &run.record;
-    let (p, d) = (rec.column(columns::LOAD).unwrap(), rec.column(columns::DISPLACEMENT).unwrap());
-    let located = rec.column(columns::DEBONDED_LENGTH).unwrap();
     let threshold = FrpBeam::paper().unwrap().control.damage_threshold;
-    let counted: Vec<f64> = run
-        .profiles
-        .iter()
-        .map(|pr| {
-            let mut scratch = vec![0.0; pr.x.len()];
-            crack::measure(&pr.x, &pr.damage, threshold, pr.x[0], &mut scratch).debonded
-        })
-        .collect();
-    let peak = p.iter().fold(0.0f64, |m, &v| m.max(v));
-    [located, &counted].map(|l| [first_reaching(p, ONSET_FRACTION * peak, l), first_reaching(d, END_DEFLECTION, l)])
+    // The same states with the former debonded length, recomputed from the damage profiles.
+    let mut counted =
+        Record::new(&[(columns::DISPLACEMENT, "mm"), (columns::LOAD, "N"), (columns::DEBONDED_LENGTH, "mm")]);
+    let (p, d) = (rec.column(columns::LOAD).unwrap(), rec.column(columns::DISPLACEMENT).unwrap());
+    for (i, pr) in run.profiles.iter().enumerate() {
+        let mut scratch = vec![0.0; pr.x.len()];
+        counted.push(&[d[i], p[i], crack::measure(&pr.x, &pr.damage, threshold, pr.x[0], &mut scratch).debonded]);
+    }
+    let onset = OnsetOfDebonding::new(ONSET_FRACTION).unwrap();
+    let end = EndOfTest::at(END_DEFLECTION).unwrap();
+    [rec, &counted].map(|r| [onset.predict(r, &[0.0]).unwrap()[0], end.predict(r, &[0.0]).unwrap()[0]])
 }
 
 /// Central-difference slopes at steps `h` and `h/2` of the parameter `which` (0: σ_t, 1: Δu_t,c):
