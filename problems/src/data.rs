@@ -160,6 +160,8 @@ pub struct Experiment {
     pub initial_crack: Option<f64>,
     /// Rows of the file left out, by reason.
     pub dropped: DroppedRows,
+    /// Measured events (`[[experiment.event]]` of a problem file; none from the data file).
+    pub events: Vec<crate::event::MeasuredEvent>,
 }
 
 impl ExperimentSpec {
@@ -306,7 +308,7 @@ impl ExperimentSpec {
             }
         };
         let name = self.file.file_stem().map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
-        Ok(Experiment { name, load, debonded_length, initial_crack, dropped })
+        Ok(Experiment { name, load, debonded_length, initial_crack, dropped, events: Vec::new() })
     }
 }
 

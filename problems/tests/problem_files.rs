@@ -371,3 +371,76 @@ fn a_budget_that_ends_before_convergence_is_said_and_qualifies_the_verdicts() {
     assert!(res.evaluations < 500 && res.converged, "{} evaluations", res.evaluations);
     assert!(!res.parameters["law.stiffness"].verdict.contains("provisional"));
 }
+
+/// The toy problem with two measured events of the patch: its peak load (160 N at the answer,
+/// stiffness 80) and the displacement at 80 N (0.5 mm at the answer).
+fn with_events(extra: &str) -> String {
+    problem_text("").replace(
+        "max_opening = 1.0\n",
+        &format!(
+            "max_opening = 1.0\n\n[[experiment.event]]\nkind = \"peak_load\"\nvalue = 0.16\nunit = \"kN\"\n\n\
+             [[experiment.event]]\nkind = \"displacement_at_load\"\nvalue = 0.5\nunit = \"mm\"\nload = 80.0\n{extra}\n"
+        ),
+    )
+}
+
+#[test]
+fn measured_events_are_terms_of_the_objective() {
+    let dir = setup_dir("events", &with_events(""));
+    let p = read(&dir).unwrap();
+    let events = &p.experiments[0].events;
+    assert_eq!(
+        events.iter().map(|e| (e.name.as_str(), e.value)).collect::<Vec<_>>(),
+        [("peak_load", 160.0), ("displacement_at_load", 0.5)]
+    );
+    let id = p.identification().unwrap();
+    let names: Vec<String> = id.weights().into_iter().map(|(n, _)| n).collect();
+    assert_eq!(names, ["F:patch", "L:patch", "E:patch:peak_load", "E:patch:displacement_at_load"]);
+    // Three kinds of terms (load, debonded length, events), balanced: f = 1 at the initial guess.
+    assert_eq!(id.objectives(), 3);
+    assert!((id.simulate(&[50.0]).unwrap().evaluation.value - 1.0).abs() < 1e-12);
+    assert!(id.simulate(&[80.0]).unwrap().evaluation.value < 1e-24);
+    // Off the answer, by hand: at stiffness 100 the peak is 200 N (φ = −40/160) and 80 N is
+    // reached at 0.4 mm (φ = 0.1/0.5).
+    let id = {
+        let dir = setup_dir(
+            "events-explicit",
+            &with_events("").replace(
+                "[optimizer]",
+                "[objective]\nweights = { load = 0.0, debonded_length = 0.0, events = 2.0 }\n\n[optimizer]",
+            ),
+        );
+        read(&dir).unwrap().identification().unwrap()
+    };
+    let off = id.simulate(&[100.0]).unwrap().evaluation;
+    let expected = 2.0 * (0.25f64.powi(2) + 0.2f64.powi(2));
+    assert!((off.value - expected).abs() < 1e-12, "{} vs {expected}", off.value);
+    assert!((off.objectives[2] - expected).abs() < 1e-12);
+    // An event's own weight multiplies its α.
+    let dir = setup_dir(
+        "events-weight",
+        &with_events("weight = 0.5").replace(
+            "[optimizer]",
+            "[objective]\nweights = { load = 1.0, debonded_length = 1.0, events = 2.0 }\n\n[optimizer]",
+        ),
+    );
+    let w = read(&dir).unwrap().identification().unwrap().weights();
+    assert_eq!(w[2..].iter().map(|(_, w)| *w).collect::<Vec<_>>(), [2.0, 1.0]);
+}
+
+#[test]
+fn bad_events_are_named_with_their_field() {
+    let cases = [
+        ("event-unit", with_events("").replace("unit = \"kN\"", "unit = \"mm\""), "event 1 (peak_load): `unit`"),
+        ("event-load", with_events("").replace("load = 80.0\n", ""), "event 2 (displacement_at_load): `load`"),
+        ("event-fraction", with_events("fraction = 0.9"), "event 2 (displacement_at_load): `fraction`"),
+        ("event-kind", with_events("").replace("\"peak_load\"", "\"peak\""), "peak_load"),
+        ("event-field", with_events("sigma = 1.0"), "sigma"),
+        ("event-twice", with_events("name = \"peak_load\""), "two events of this experiment are named `peak_load`"),
+    ];
+    for (name, text, expect) in cases {
+        let msg = read(&setup_dir(name, &text)).unwrap_err().to_string();
+        eprintln!("{name}: {msg}");
+        assert!(msg.contains(expect), "{name}: `{msg}` should mention `{expect}`");
+    }
+}
