@@ -275,3 +275,18 @@ fn other_crack_patterns_and_effects_also_run_to_complete_debonding() {
         assert!(*p.last().unwrap() < 0.75 * pmax, "{name}: {} vs {pmax}", p.last().unwrap());
     }
 }
+
+#[test]
+fn midspan_moment_is_half_the_load_times_the_shear_span() {
+    // Four-point bending, total load P: P/2 at each load point, 1200 mm from its support
+    // ((3600 − 1200)/2), so M = 600 mm × P between the load points (the paper's moment–deflection).
+    let beam = paper(10.0);
+    assert_eq!(beam.shear_span(), 1200.0);
+    let rec = beam.run(&FrpBeam::table8_law().unwrap(), false).unwrap().record;
+    let (p, m) = (rec.column(columns::LOAD).unwrap(), rec.column(beam_columns::MIDSPAN_MOMENT).unwrap());
+    assert!(p.len() > 10);
+    for (p, m) in p.iter().zip(m) {
+        assert!((m - 600.0 * p).abs() <= 1e-9 * m.abs(), "{m} vs 600 × {p}");
+    }
+    assert_eq!(rec.unit(beam_columns::MIDSPAN_MOMENT), Some("N·mm"));
+}

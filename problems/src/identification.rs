@@ -207,14 +207,15 @@ impl Identification {
                 ));
             }
             let curve = |t: Term| Box::new(t.response().expect("a curve term"));
+            // The load, or the mid-span moment (the paper's moment–deflection curve of a beam).
             let mut terms = vec![ObjectiveTerm {
                 name: format!("F:{}", e.name),
-                response: curve(Term::Load),
+                response: Box::new(ColumnResponse::new(columns::DISPLACEMENT, e.ordinate.column())),
                 data: e.load.clone(),
                 weight: 1.0,
             }];
             let mut kinds = vec![Term::Load];
-            let mut units = vec![Term::Load.unit()];
+            let mut units = vec![e.ordinate.unit()];
             if let (true, Some(l)) = (use_debonded_length, &e.debonded_length) {
                 if l.norm() > 0.0 {
                     terms.push(ObjectiveTerm {

@@ -246,6 +246,7 @@ fn experiment(s: &Synthetic) -> Experiment {
         initial_crack: None,
         dropped: Default::default(),
         events: Vec::new(),
+        ordinate: Default::default(),
     }
 }
 

@@ -444,3 +444,18 @@ fn bad_events_are_named_with_their_field() {
         assert!(msg.contains(expect), "{name}: `{msg}` should mention `{expect}`");
     }
 }
+
+#[test]
+fn a_moment_curve_is_compared_with_the_midspan_moment_column() {
+    // The toy patch has no `midspan_moment` column: a moment curve asks for it, by name.
+    let text =
+        problem_text("").replace("load = \"P\"", "load = \"P\"\nordinate = \"midspan_moment\"\nmoment_unit = \"kN·m\"");
+    let p = read(&setup_dir("moment", &text)).unwrap();
+    // Read in kN·m, held in N·mm.
+    assert_eq!(p.experiments[0].load.y()[10], 160.0e6);
+    let err = p.identification().unwrap_err().to_string();
+    assert!(err.contains("midspan_moment"), "{err}");
+    let bad = problem_text("").replace("load = \"P\"", "load = \"P\"\nordinate = \"moment\"");
+    let err = read(&setup_dir("moment-bad", &bad)).unwrap_err().to_string();
+    assert!(err.contains("midspan_moment"), "{err}");
+}

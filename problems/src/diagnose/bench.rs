@@ -300,6 +300,7 @@ fn synthetic_experiment(
         initial_crack: None,
         dropped: Default::default(),
         events: Vec::new(),
+        ordinate: Default::default(),
     })
 }
 

@@ -74,6 +74,12 @@ impl Gauge {
     pub fn new(experiments: &[Experiment], use_length: bool, noise_levels: NoiseLevels) -> Result<Self> {
         let mut blocks = Vec::new();
         for e in experiments {
+            if e.ordinate != crate::data::Ordinate::Load {
+                return Err(CzError::config(
+                    format!("experiment `{}`", e.name),
+                    "the diagnosis compares load curves; this one is a moment (`ordinate`)",
+                ));
+            }
             let (x, y) = (e.load.x().to_vec(), e.load.y().to_vec());
             let sigma = noise_levels.load.unwrap_or_else(|| noise::estimate(&x, &y, false));
             blocks.push(Block {
