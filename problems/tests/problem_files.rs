@@ -459,3 +459,25 @@ fn a_moment_curve_is_compared_with_the_midspan_moment_column() {
     let err = read(&setup_dir("moment-bad", &bad)).unwrap_err().to_string();
     assert!(err.contains("midspan_moment"), "{err}");
 }
+
+#[test]
+fn truth_files_read_events_with_noise_and_rounding() {
+    let dir = std::env::temp_dir().join(format!("czid-pf-{}-truth-events", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let truth = "[law]\ntype = \"toy_spring\"\nstiffness = 50.0\n[model]\ntype = \"toy_patch\"\narea = 2.0\n\
+                 max_opening = 1.0\n[noise]\npoints = 10\nmax_displacement = 0.8\n\
+                 [[event]]\nkind = \"peak_load\"\nresolution = 30.0\n\
+                 [[event]]\nkind = \"debonded_length_at_end\"\nsd = 0.01\n";
+    std::fs::write(dir.join("truth.toml"), truth).unwrap();
+    let t = czid_problems::synthetic::TruthFile::read(&dir.join("truth.toml")).unwrap();
+    let (data, events) = t.generate_with_events().unwrap();
+    assert_eq!(data.displacement.len(), 10);
+    // The peak load of the run (100 N at 1 mm), read to 30 N; the debonded length (= the
+    // opening) at the last displacement read, 0.8 mm, with 0.01 mm of noise.
+    assert_eq!((events[0].truth, events[0].read), (100.0, 90.0));
+    assert!((events[1].truth - 0.8).abs() < 1e-12);
+    assert!((events[1].read - 0.8).abs() < 0.05 && events[1].read != 0.8);
+    assert_eq!(events[1].spec.at, Some(0.8));
+    // Reproducible.
+    assert_eq!(t.generate_with_events().unwrap().1, events);
+}
