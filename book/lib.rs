@@ -15,6 +15,8 @@ pub mod forward_models {}
 pub mod beam_or_continuum {}
 #[doc = include_str!("src/frp_beam.md")]
 pub mod frp_beam {}
+#[doc = include_str!("src/frp_beam_identification.md")]
+pub mod frp_beam_identification {}
 #[doc = include_str!("src/optimizers.md")]
 pub mod optimizers {}
 #[doc = include_str!("src/cluster.md")]

@@ -86,7 +86,8 @@ enum Command {
     },
     /// Make a synthetic test (CSV) from a truth file: a law, a model and a noise description.
     Synthesize {
-        /// Truth file (TOML with [law], [model], [noise]).
+        /// Truth file (TOML with [law], [model], [noise] and optional [[event]]s, printed as
+        /// problem-file event tables).
         truth: PathBuf,
         /// CSV file to write (columns displacement_mm, load_N, debonded_length_mm).
         #[arg(long)]
@@ -379,9 +380,15 @@ fn run_synthesize(truth: &Path, out: &Path, force: bool) -> Result<(), CzError> 
             message: "exists; pass --force to overwrite".into(),
         });
     }
-    let data = TruthFile::read(truth)?.generate()?;
+    let (data, events) = TruthFile::read(truth)?.generate_with_events()?;
     czid_problems::output::write_atomic(out, data.to_csv().as_bytes())?;
     println!("{} synthetic readings written to {}", data.displacement.len(), out.display());
+    for e in &events {
+        // The reading as a problem file's event table (paste it under the experiment).
+        let mut table = toml::to_string(&e.spec).map_err(|err| CzError::config("synthesize", err.to_string()))?;
+        table = table.lines().filter(|l| !l.starts_with("load_unit")).collect::<Vec<_>>().join("\n");
+        println!("# model value {:.3} {}\n[[experiment.event]]\n{table}\n", e.truth, e.spec.unit);
+    }
     Ok(())
 }
 

@@ -9,7 +9,8 @@
 //!   [`Record`] of named, unit-carrying columns per converged step.
 //! * [`Response`]: a curve extracted from a record (load vs displacement, debonded length vs
 //!   displacement, ...), compared with experimental [`Curve`]s by the [`CompositeObjective`]
-//!   (Eq. 14–18 of Shi & Zhang).
+//!   (Eq. 14–18 of Shi & Zhang); [`event`] holds the scalar ones (peak load, debonded length at
+//!   the onset of debonding and at the end of the test, displacement at a load).
 //! * [`ParameterSpace`]: named parameters with units, bounds and optional log scale, mapping an
 //!   optimizer's vector onto a configured law or model and back.
 //! * [`Optimizer`] and [`Problem`]: the contract between search methods and what they minimise.
@@ -22,6 +23,7 @@
 pub mod curve;
 pub mod effect;
 pub mod error;
+pub mod event;
 pub mod law;
 pub mod model;
 pub mod noise;

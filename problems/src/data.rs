@@ -58,6 +58,63 @@ impl ForceUnit {
     }
 }
 
+/// What a test's `load` column holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ordinate {
+    /// The load (the record's `load`, N).
+    #[default]
+    Load,
+    /// The mid-span moment of a beam in four-point bending (the record's `midspan_moment`,
+    /// `P/2 ×` shear span for a total load `P`), in `moment_unit`: the paper's moment–deflection
+    /// curve.
+    MidspanMoment,
+}
+
+impl Ordinate {
+    /// The record column it is compared with.
+    pub fn column(self) -> &'static str {
+        match self {
+            Ordinate::Load => czid_core::columns::LOAD,
+            Ordinate::MidspanMoment => czid_models::frp::beam::beam_columns::MIDSPAN_MOMENT,
+        }
+    }
+
+    /// Its unit once read (N or N·mm).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Ordinate::Load => "N",
+            Ordinate::MidspanMoment => "N·mm",
+        }
+    }
+}
+
+/// Unit of a moment column.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MomentUnit {
+    /// Newton-millimetres (czid's unit).
+    #[default]
+    #[serde(rename = "N·mm", alias = "N.mm", alias = "Nmm")]
+    NewtonMillimetre,
+    /// Newton-metres.
+    #[serde(rename = "N·m", alias = "N.m", alias = "Nm")]
+    NewtonMetre,
+    /// Kilonewton-metres.
+    #[serde(rename = "kN·m", alias = "kN.m", alias = "kNm")]
+    KiloNewtonMetre,
+}
+
+impl MomentUnit {
+    /// Factor to N·mm.
+    pub fn to_newton_millimetre(self) -> f64 {
+        match self {
+            MomentUnit::NewtonMillimetre => 1.0,
+            MomentUnit::NewtonMetre => 1e3,
+            MomentUnit::KiloNewtonMetre => 1e6,
+        }
+    }
+}
+
 /// What a crack column holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -77,8 +134,14 @@ pub struct ExperimentSpec {
     pub file: PathBuf,
     /// Column with the control displacement (e.g. load-line opening).
     pub displacement: String,
-    /// Column with the load.
+    /// Column with the load (or, with `ordinate = "midspan_moment"`, the mid-span moment).
     pub load: String,
+    /// What the `load` column holds: the load (default) or the mid-span moment.
+    #[serde(default)]
+    pub ordinate: Ordinate,
+    /// Unit of a moment column (`N·mm`, `N·m`, `kN·m`; default N·mm).
+    #[serde(default)]
+    pub moment_unit: MomentUnit,
     /// Column with the crack or debonded length, if measured.
     #[serde(default)]
     pub crack: Option<String>,
@@ -160,6 +223,10 @@ pub struct Experiment {
     pub initial_crack: Option<f64>,
     /// Rows of the file left out, by reason.
     pub dropped: DroppedRows,
+    /// Measured events (`[[experiment.event]]` of a problem file; none from the data file).
+    pub events: Vec<crate::event::MeasuredEvent>,
+    /// What `load` holds (the load, or the mid-span moment in N·mm).
+    pub ordinate: Ordinate,
 }
 
 impl ExperimentSpec {
@@ -190,7 +257,11 @@ impl ExperimentSpec {
         let iy = find("load", &self.load)?;
         let ic = self.crack.as_deref().map(|c| find("crack", c)).transpose()?;
 
-        let (lu, fu) = (self.length_unit.to_mm(), self.force_unit.to_newton());
+        let lu = self.length_unit.to_mm();
+        let fu = match self.ordinate {
+            Ordinate::Load => self.force_unit.to_newton(),
+            Ordinate::MidspanMoment => self.moment_unit.to_newton_millimetre(),
+        };
         let mut rows: Vec<Row> = Vec::new();
         let mut dropped = DroppedRows::default();
         for (i, record) in reader.records().enumerate() {
@@ -306,7 +377,15 @@ impl ExperimentSpec {
             }
         };
         let name = self.file.file_stem().map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
-        Ok(Experiment { name, load, debonded_length, initial_crack, dropped })
+        Ok(Experiment {
+            name,
+            load,
+            debonded_length,
+            initial_crack,
+            dropped,
+            events: Vec::new(),
+            ordinate: self.ordinate,
+        })
     }
 }
 
@@ -384,6 +463,8 @@ mod tests {
             file: file.into(),
             displacement: "Disp".into(),
             load: "Force".into(),
+            ordinate: Ordinate::Load,
+            moment_unit: MomentUnit::NewtonMillimetre,
             crack: Some("CrackExt".into()),
             crack_measure: CrackMeasure::CrackLength,
             length_unit: LengthUnit::Millimetre,

@@ -4,7 +4,7 @@
 
 use czid_core::objective::balanced_weights;
 use czid_core::{
-    columns, CohesiveLaw, ColumnResponse, CompositeObjective, CzError, Evaluation, ForwardModel, ObjectiveTerm,
+    columns, CohesiveLaw, ColumnResponse, CompositeObjective, Curve, CzError, Evaluation, ForwardModel, ObjectiveTerm,
     ParameterSpace, Problem, Record, Result,
 };
 use rayon::prelude::*;
@@ -48,6 +48,9 @@ pub enum Term {
     /// Debonded length against displacement (φ_L).
     #[serde(rename = "L")]
     DebondedLength,
+    /// A measured event: one value of the run (φ_E, see [`crate::event`]).
+    #[serde(rename = "E")]
+    Event,
 }
 
 /// A term's root-mean-square error at the identified parameters ([`Identification::term_errors`]).
@@ -67,6 +70,7 @@ impl Term {
         match self {
             Term::Load => "F",
             Term::DebondedLength => "L",
+            Term::Event => "E",
         }
     }
 
@@ -75,29 +79,34 @@ impl Term {
         match self {
             Term::Load => "load",
             Term::DebondedLength => "debonded length",
+            Term::Event => "event",
         }
     }
 
-    /// Its unit.
+    /// Its unit (an event's is its own: N or mm).
     pub fn unit(self) -> &'static str {
         match self {
             Term::Load => "N",
             Term::DebondedLength => "mm",
+            Term::Event => "N or mm",
         }
     }
 
-    /// The record column it is read from (against [`columns::DISPLACEMENT`]).
-    pub fn column(self) -> &'static str {
+    /// The record column a curve term is read from (against [`columns::DISPLACEMENT`]); events
+    /// read their own (`None`).
+    pub fn column(self) -> Option<&'static str> {
         match self {
-            Term::Load => columns::LOAD,
-            Term::DebondedLength => columns::DEBONDED_LENGTH,
+            Term::Load => Some(columns::LOAD),
+            Term::DebondedLength => Some(columns::DEBONDED_LENGTH),
+            Term::Event => None,
         }
     }
 
-    /// The simulated response compared with it: its column against the displacement (the same
-    /// for identification and diagnosis).
-    pub fn response(self) -> ColumnResponse {
-        ColumnResponse::new(columns::DISPLACEMENT, self.column())
+    /// The simulated response a curve term is compared with: its column against the
+    /// displacement (the same for identification and diagnosis); `None` for events (each has
+    /// its own, [`crate::event::MeasuredEvent::response`]).
+    pub fn response(self) -> Option<ColumnResponse> {
+        self.column().map(|c| ColumnResponse::new(columns::DISPLACEMENT, c))
     }
 }
 
@@ -113,6 +122,10 @@ struct Fit {
     name: String,
     objective: CompositeObjective,
     kinds: Vec<Term>,
+    /// Factor on each term's weight (an event's `weight`; 1 for curves).
+    factors: Vec<f64>,
+    /// Unit of each term.
+    units: Vec<&'static str>,
 }
 
 /// The runs of a setup's experiments: a record per experiment (partial when a run stopped part
@@ -245,25 +258,43 @@ impl Identification {
                     "has no forward model (each experiment needs a `model` table)",
                 ));
             }
+            let curve = |t: Term| Box::new(t.response().expect("a curve term"));
+            // The load, or the mid-span moment (the paper's moment–deflection curve of a beam).
             let mut terms = vec![ObjectiveTerm {
                 name: format!("F:{}", e.name),
-                response: Box::new(Term::Load.response()),
+                response: Box::new(ColumnResponse::new(columns::DISPLACEMENT, e.ordinate.column())),
                 data: e.load.clone(),
                 weight: 1.0,
             }];
             let mut kinds = vec![Term::Load];
+            let mut units = vec![e.ordinate.unit()];
             if let (true, Some(l)) = (use_debonded_length, &e.debonded_length) {
                 if l.norm() > 0.0 {
                     terms.push(ObjectiveTerm {
                         name: format!("L:{}", e.name),
-                        response: Box::new(Term::DebondedLength.response()),
+                        response: curve(Term::DebondedLength),
                         data: l.clone(),
                         weight: 1.0,
                     });
                     kinds.push(Term::DebondedLength);
+                    units.push(Term::DebondedLength.unit());
                 }
             }
-            fits.push(Fit { name: e.name.clone(), objective: CompositeObjective::new(terms)?, kinds });
+            let mut factors = vec![1.0; terms.len()];
+            for ev in &e.events {
+                // One reading; its abscissa is not used by an event response.
+                terms.push(ObjectiveTerm {
+                    name: format!("E:{}:{}", e.name, ev.name),
+                    response: ev.response.boxed(),
+                    data: Curve::new(vec![0.0], vec![ev.value])?,
+                    weight: ev.weight,
+                });
+                kinds.push(Term::Event);
+                factors.push(ev.weight);
+                units.push(ev.unit());
+            }
+            let objective = CompositeObjective::new(terms)?;
+            fits.push(Fit { name: e.name.clone(), objective, kinds, factors, units });
         }
         // Fail early, with the path named, if a parameter does not exist in the setup.
         space.read(&setup)?;
@@ -288,14 +319,17 @@ impl Identification {
     /// Term kinds present, in the order [`Evaluation::objectives`] reports them.
     pub fn term_kinds(&self) -> Vec<Term> {
         let mut kinds = vec![Term::Load];
-        if self.fits.iter().any(|f| f.kinds.contains(&Term::DebondedLength)) {
-            kinds.push(Term::DebondedLength);
+        for k in [Term::DebondedLength, Term::Event] {
+            if self.fits.iter().any(|f| f.kinds.contains(&k)) {
+                kinds.push(k);
+            }
         }
         kinds
     }
 
     /// Sets the weights so that, at the initial values, every term of every experiment contributes
-    /// equally and the objective is 1 (the paper's choice of α).
+    /// equally and the objective is 1 (the paper's choice of α); an event's term then has its
+    /// `weight` times that.
     pub fn balance_weights(&mut self) -> Result<()> {
         let x0 = self.initial()?;
         let outcome = self.simulate(&x0)?;
@@ -308,8 +342,25 @@ impl Identification {
         let all: Vec<f64> = parts.iter().flatten().copied().collect();
         let mut weights = balanced_weights(&all).into_iter();
         for (fit, parts) in self.fits.iter_mut().zip(parts) {
-            let w: Vec<f64> = weights.by_ref().take(parts.len()).collect();
+            let w: Vec<f64> = weights.by_ref().take(parts.len()).zip(&fit.factors).map(|(w, f)| w * f).collect();
             fit.objective.set_weights(&w)?;
+        }
+        Ok(())
+    }
+
+    /// Sets α_E of every event term (times the event's own `weight`); the curve terms keep theirs.
+    pub fn set_event_weight(&mut self, alpha_e: f64) -> Result<()> {
+        for fit in &mut self.fits {
+            let mut w = fit.objective.weights();
+            for ((w, k), f) in w.iter_mut().zip(&fit.kinds).zip(&fit.factors) {
+                if *k == Term::Event {
+                    *w = alpha_e * f;
+                }
+            }
+            fit.objective.set_weights(&w)?;
+        }
+        if self.weights().iter().all(|(_, w)| *w == 0.0) {
+            return Err(CzError::config("[objective] weights", "every compared response has weight 0"));
         }
         Ok(())
     }
@@ -317,7 +368,16 @@ impl Identification {
     /// Sets the weights of the load and debonded-length terms (α_F, α_L) for every experiment.
     pub fn set_weights(&mut self, alpha_f: f64, alpha_l: f64) -> Result<()> {
         for fit in &mut self.fits {
-            let w: Vec<f64> = fit.kinds.iter().map(|k| if *k == Term::Load { alpha_f } else { alpha_l }).collect();
+            let w: Vec<f64> = fit
+                .kinds
+                .iter()
+                .zip(&fit.factors)
+                .map(|(k, f)| match k {
+                    Term::Load => alpha_f,
+                    Term::DebondedLength => alpha_l,
+                    Term::Event => *f,
+                })
+                .collect();
             fit.objective.set_weights(&w)?;
         }
         // With every weight zero the objective is 0 everywhere and any parameters "fit".
@@ -395,15 +455,11 @@ impl Identification {
         let mut out = Vec::new();
         for fit in &self.fits {
             let v = fit.objective.evaluate(&outcome.scored(&fit.name))?;
-            for ((term, kind), misfit) in fit.objective.terms().iter().zip(&fit.kinds).zip(v.terms) {
+            for ((term, unit), misfit) in fit.objective.terms().iter().zip(&fit.units).zip(v.terms) {
                 let y = term.data.y();
                 let mean_square = y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64;
                 let peak = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let value = (misfit * mean_square).sqrt();
-                let unit = match kind {
-                    Term::Load => "N",
-                    Term::DebondedLength => "mm",
-                };
                 let percent_of_peak = if peak > 0.0 { 100.0 * value / peak } else { f64::NAN };
                 out.push((term.name.clone(), RmsError { value, unit: unit.to_string(), percent_of_peak }));
             }

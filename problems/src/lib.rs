@@ -19,6 +19,7 @@
 pub mod compare;
 pub mod data;
 pub mod diagnose;
+pub mod event;
 pub mod farm;
 pub mod identifiability;
 pub mod identification;

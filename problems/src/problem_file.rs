@@ -17,6 +17,10 @@
 //! [experiment.model]          # the forward model of this test
 //! type = "dcb"
 //! # ... geometry, elastic constants, effects
+//! [[experiment.event]]        # optional: single measured values (see `crate::event`)
+//! kind = "debonded_length_at_onset"
+//! value = 436.0
+//! unit = "mm"
 //!
 //! [[parameter]]               # what is identified
 //! path = "law.strength_n"     # `law.<key>` or `models.<experiment>.<key>`
@@ -27,7 +31,7 @@
 //!
 //! [objective]
 //! debonded_length = true      # fit the debonded length too (when the data has it)
-//! weights = "balanced"        # or { load = 1.0, debonded_length = 0.5 }
+//! weights = "balanced"        # or { load = 1.0, debonded_length = 0.5, events = 1.0 }
 //!
 //! [optimizer]
 //! type = "miga"
@@ -42,6 +46,7 @@
 //! ```
 
 use crate::data::{Experiment, ExperimentSpec};
+use crate::event::EventSpec;
 use crate::identification::{Identification, Setup};
 use czid_core::param::duplicate;
 use czid_core::{CohesiveLaw, CzError, ForwardModel, Parameter, ParameterSpace, Result};
@@ -60,6 +65,9 @@ pub struct ExperimentEntry {
     pub data: ExperimentSpec,
     /// The simulated test.
     pub model: Box<dyn ForwardModel>,
+    /// Measured events (`[[experiment.event]]`, see [`crate::event`]).
+    #[serde(default)]
+    pub event: Vec<EventSpec>,
 }
 
 /// How the objective's terms are weighted.
@@ -68,13 +76,16 @@ pub struct ExperimentEntry {
 pub enum Weights {
     /// `"balanced"`: equal contributions at the initial guess (the paper's choice).
     Named(String),
-    /// Explicit α for the load and debonded-length terms.
+    /// Explicit α for the load, debonded-length and event terms.
     Explicit {
         /// α_F.
         load: f64,
         /// α_L.
         #[serde(default = "one")]
         debonded_length: f64,
+        /// α_E, for every `[[experiment.event]]` (times its own `weight`).
+        #[serde(default = "one")]
+        events: f64,
     },
 }
 
@@ -283,6 +294,18 @@ impl LoadedProblem {
             if let Some(n) = &entry.name {
                 data.name = n.clone();
             }
+            let last = data.load.x().last().copied().unwrap_or(0.0);
+            for (j, ev) in entry.event.iter().enumerate() {
+                let owner = format!("{shown}, experiment {}, event {}", i + 1, j + 1);
+                let measured = ev.check(&owner, last)?;
+                if data.events.iter().any(|e| e.name == measured.name) {
+                    return Err(CzError::config(
+                        &owner,
+                        format!("two events of this experiment are named `{}`; give each a `name`", measured.name),
+                    ));
+                }
+                data.events.push(measured);
+            }
             if names.contains(&data.name) {
                 return Err(CzError::config(
                     &shown,
@@ -344,7 +367,10 @@ impl LoadedProblem {
                     format!("`{n}` is not a weighting; use \"balanced\" or {{ load = .., debonded_length = .. }}"),
                 ))
             }
-            Weights::Explicit { load, debonded_length } => id.set_weights(*load, *debonded_length)?,
+            Weights::Explicit { load, debonded_length, events } => {
+                id.set_weights(*load, *debonded_length)?;
+                id.set_event_weight(*events)?;
+            }
         }
         Ok(id)
     }

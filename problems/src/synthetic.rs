@@ -130,6 +130,54 @@ pub struct TruthFile {
     /// Noise and sampling (default: no noise, 200 readings).
     #[serde(default)]
     pub noise: NoiseSpec,
+    /// Events read off the synthetic test (`[[event]]`), e.g. debonded lengths read to 10 mm.
+    #[serde(default)]
+    pub event: Vec<TruthEvent>,
+}
+
+/// An event of a synthetic test (`[[event]]` of a truth file): the model's value of a
+/// [`crate::event::EventKind`] response, perturbed by Gaussian noise and rounded as a reading.
+///
+/// ```toml
+/// [[event]]
+/// kind = "debonded_length_at_onset"
+/// fraction = 0.98        # onset only (default 0.98)
+/// sd = 10.0              # mm (N for the peak load): standard deviation of the reading
+/// resolution = 5.0       # the reading is rounded to a multiple of this (0: not rounded)
+/// ```
+///
+/// The end of the test is the last displacement read (`[noise] max_displacement`, or the end of
+/// the run). The noise is drawn after the curve's, from the same seed, in the order of the events.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TruthEvent {
+    /// What is read.
+    pub kind: crate::event::EventKind,
+    /// Onset: fraction of the peak load.
+    #[serde(default)]
+    pub fraction: Option<f64>,
+    /// Displacement at load: the load (N).
+    #[serde(default)]
+    pub load: Option<f64>,
+    /// Standard deviation of the reading (mm or N).
+    #[serde(default)]
+    pub sd: f64,
+    /// Rounding of the reading (mm or N; 0: none).
+    #[serde(default)]
+    pub resolution: f64,
+}
+
+/// An event's true and read values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReadEvent {
+    /// What was read.
+    pub kind: crate::event::EventKind,
+    /// The model's value (mm or N).
+    pub truth: f64,
+    /// The reading: the value plus noise, rounded.
+    pub read: f64,
+    /// The spec the value was computed with (for the problem file).
+    pub spec: crate::event::EventSpec,
 }
 
 /// The `[noise]` table of a truth file; every field has a default (no noise, seed 1, 200
@@ -170,13 +218,47 @@ impl TruthFile {
 
     /// Simulates and samples with noise.
     pub fn generate(&self) -> Result<Synthetic> {
+        Ok(self.generate_with_events()?.0)
+    }
+
+    /// Simulates, samples with noise and reads the `[[event]]`s.
+    pub fn generate_with_events(&self) -> Result<(Synthetic, Vec<ReadEvent>)> {
+        use crate::event::{EventKind, EventSpec};
         let record = self.model.simulate(self.law.as_ref()).map_err(|f| CzError::Simulation(f.to_string()))?;
         let n = &self.noise;
-        synthesize(
+        let data = synthesize(
             &record,
             n.points,
             n.max_displacement,
             &Noise { load_sd: n.load_sd, length_sd: n.length_sd, seed: n.seed },
-        )
+        )?;
+        // The events' noise: a stream of its own, from the same seed, after the curve's draws.
+        let mut rng = ChaCha8Rng::seed_from_u64(n.seed);
+        for _ in 0..2 * n.points {
+            gaussian(&mut rng);
+        }
+        let last = *data.displacement.last().expect("at least 2 readings");
+        let mut events = Vec::new();
+        for (j, e) in self.event.iter().enumerate() {
+            let unit = if e.kind == EventKind::PeakLoad { "N" } else { "mm" };
+            let spec = EventSpec {
+                kind: e.kind,
+                name: None,
+                value: 1.0,
+                unit: unit.into(),
+                weight: None,
+                fraction: e.fraction,
+                at: (e.kind == EventKind::DebondedLengthAtEnd).then_some(last),
+                load: e.load,
+                load_unit: Default::default(),
+            };
+            let owner = format!("truth file, event {}", j + 1);
+            let measured = spec.check(&owner, last)?;
+            let truth = measured.response.boxed().predict(&record, &[0.0])?[0];
+            let noisy = truth + e.sd * gaussian(&mut rng);
+            let read = if e.resolution > 0.0 { (noisy / e.resolution).round() * e.resolution } else { noisy };
+            events.push(ReadEvent { kind: e.kind, truth, read, spec: EventSpec { value: read, ..spec } });
+        }
+        Ok((data, events))
     }
 }

@@ -166,6 +166,8 @@ fn diagnose_made_by(bridging: f64, continuum: bool) -> czid_problems::diagnose::
         debonded_length: Some(Curve::new(data.displacement, data.debonded_length).unwrap()),
         initial_crack: None,
         dropped: Default::default(),
+        events: Vec::new(),
+        ordinate: Default::default(),
     };
     let space = ParameterSpace::new(vec![
         Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),

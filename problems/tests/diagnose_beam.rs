@@ -245,6 +245,8 @@ fn experiment(s: &Synthetic) -> Experiment {
         debonded_length: Some(Curve::new(s.displacement.clone(), s.debonded_length.clone()).unwrap()),
         initial_crack: None,
         dropped: Default::default(),
+        events: Vec::new(),
+        ordinate: Default::default(),
     }
 }
 

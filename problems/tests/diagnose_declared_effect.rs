@@ -126,6 +126,8 @@ fn a_planted_declared_effect_is_named_by_the_diagnosis() {
         debonded_length: Some(Curve::new(data.displacement, data.debonded_length).unwrap()),
         initial_crack: None,
         dropped: Default::default(),
+        events: Vec::new(),
+        ordinate: Default::default(),
     };
     let space = ParameterSpace::new(vec![
         Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),

@@ -341,6 +341,8 @@ fn csv_data_never_panics_and_what_is_accepted_is_sound() {
             file: "data.csv".into(),
             displacement: if rng.random_bool(0.8) { "Disp".into() } else { pick(&mut rng) },
             load: if rng.random_bool(0.8) { "Force".into() } else { pick(&mut rng) },
+            ordinate: Default::default(),
+            moment_unit: Default::default(),
             crack: rng.random_bool(0.5).then(|| pick(&mut rng)),
             crack_measure: if rng.random() { CrackMeasure::CrackLength } else { CrackMeasure::DebondedLength },
             length_unit: [LengthUnit::Millimetre, LengthUnit::Metre, LengthUnit::Inch][rng.random_range(0..3)],

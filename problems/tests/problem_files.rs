@@ -407,3 +407,113 @@ fn a_run_that_fails_part_way_costs_every_reading_it_did_not_reach() {
     assert!(complete.failures.is_empty());
     assert!(f > 10.0 * complete.evaluation.value, "{f} vs {}", complete.evaluation.value);
 }
+
+/// The toy problem with two measured events of the patch: its peak load (160 N at the answer,
+/// stiffness 80) and the displacement at 80 N (0.5 mm at the answer).
+fn with_events(extra: &str) -> String {
+    problem_text("").replace(
+        "max_opening = 1.0\n",
+        &format!(
+            "max_opening = 1.0\n\n[[experiment.event]]\nkind = \"peak_load\"\nvalue = 0.16\nunit = \"kN\"\n\n\
+             [[experiment.event]]\nkind = \"displacement_at_load\"\nvalue = 0.5\nunit = \"mm\"\nload = 80.0\n{extra}\n"
+        ),
+    )
+}
+
+#[test]
+fn measured_events_are_terms_of_the_objective() {
+    let dir = setup_dir("events", &with_events(""));
+    let p = read(&dir).unwrap();
+    let events = &p.experiments[0].events;
+    assert_eq!(
+        events.iter().map(|e| (e.name.as_str(), e.value)).collect::<Vec<_>>(),
+        [("peak_load", 160.0), ("displacement_at_load", 0.5)]
+    );
+    let id = p.identification().unwrap();
+    let names: Vec<String> = id.weights().into_iter().map(|(n, _)| n).collect();
+    assert_eq!(names, ["F:patch", "L:patch", "E:patch:peak_load", "E:patch:displacement_at_load"]);
+    // Three kinds of terms (load, debonded length, events), balanced: f = 1 at the initial guess.
+    assert_eq!(id.objectives(), 3);
+    assert!((id.simulate(&[50.0]).unwrap().evaluation.value - 1.0).abs() < 1e-12);
+    assert!(id.simulate(&[80.0]).unwrap().evaluation.value < 1e-24);
+    // Off the answer, by hand: at stiffness 100 the peak is 200 N (φ = −40/160) and 80 N is
+    // reached at 0.4 mm (φ = 0.1/0.5).
+    let id = {
+        let dir = setup_dir(
+            "events-explicit",
+            &with_events("").replace(
+                "[optimizer]",
+                "[objective]\nweights = { load = 0.0, debonded_length = 0.0, events = 2.0 }\n\n[optimizer]",
+            ),
+        );
+        read(&dir).unwrap().identification().unwrap()
+    };
+    let off = id.simulate(&[100.0]).unwrap().evaluation;
+    let expected = 2.0 * (0.25f64.powi(2) + 0.2f64.powi(2));
+    assert!((off.value - expected).abs() < 1e-12, "{} vs {expected}", off.value);
+    assert!((off.objectives[2] - expected).abs() < 1e-12);
+    // An event's own weight multiplies its α.
+    let dir = setup_dir(
+        "events-weight",
+        &with_events("weight = 0.5").replace(
+            "[optimizer]",
+            "[objective]\nweights = { load = 1.0, debonded_length = 1.0, events = 2.0 }\n\n[optimizer]",
+        ),
+    );
+    let w = read(&dir).unwrap().identification().unwrap().weights();
+    assert_eq!(w[2..].iter().map(|(_, w)| *w).collect::<Vec<_>>(), [2.0, 1.0]);
+}
+
+#[test]
+fn bad_events_are_named_with_their_field() {
+    let cases = [
+        ("event-unit", with_events("").replace("unit = \"kN\"", "unit = \"mm\""), "event 1 (peak_load): `unit`"),
+        ("event-load", with_events("").replace("load = 80.0\n", ""), "event 2 (displacement_at_load): `load`"),
+        ("event-fraction", with_events("fraction = 0.9"), "event 2 (displacement_at_load): `fraction`"),
+        ("event-kind", with_events("").replace("\"peak_load\"", "\"peak\""), "peak_load"),
+        ("event-field", with_events("sigma = 1.0"), "sigma"),
+        ("event-twice", with_events("name = \"peak_load\""), "two events of this experiment are named `peak_load`"),
+    ];
+    for (name, text, expect) in cases {
+        let msg = read(&setup_dir(name, &text)).unwrap_err().to_string();
+        eprintln!("{name}: {msg}");
+        assert!(msg.contains(expect), "{name}: `{msg}` should mention `{expect}`");
+    }
+}
+
+#[test]
+fn a_moment_curve_is_compared_with_the_midspan_moment_column() {
+    // The toy patch has no `midspan_moment` column: a moment curve asks for it, by name.
+    let text =
+        problem_text("").replace("load = \"P\"", "load = \"P\"\nordinate = \"midspan_moment\"\nmoment_unit = \"kN·m\"");
+    let p = read(&setup_dir("moment", &text)).unwrap();
+    // Read in kN·m, held in N·mm.
+    assert_eq!(p.experiments[0].load.y()[10], 160.0e6);
+    let err = p.identification().unwrap_err().to_string();
+    assert!(err.contains("midspan_moment"), "{err}");
+    let bad = problem_text("").replace("load = \"P\"", "load = \"P\"\nordinate = \"moment\"");
+    let err = read(&setup_dir("moment-bad", &bad)).unwrap_err().to_string();
+    assert!(err.contains("midspan_moment"), "{err}");
+}
+
+#[test]
+fn truth_files_read_events_with_noise_and_rounding() {
+    let dir = std::env::temp_dir().join(format!("czid-pf-{}-truth-events", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let truth = "[law]\ntype = \"toy_spring\"\nstiffness = 50.0\n[model]\ntype = \"toy_patch\"\narea = 2.0\n\
+                 max_opening = 1.0\n[noise]\npoints = 10\nmax_displacement = 0.8\n\
+                 [[event]]\nkind = \"peak_load\"\nresolution = 30.0\n\
+                 [[event]]\nkind = \"debonded_length_at_end\"\nsd = 0.01\n";
+    std::fs::write(dir.join("truth.toml"), truth).unwrap();
+    let t = czid_problems::synthetic::TruthFile::read(&dir.join("truth.toml")).unwrap();
+    let (data, events) = t.generate_with_events().unwrap();
+    assert_eq!(data.displacement.len(), 10);
+    // The peak load of the run (100 N at 1 mm), read to 30 N; the debonded length (= the
+    // opening) at the last displacement read, 0.8 mm, with 0.01 mm of noise.
+    assert_eq!((events[0].truth, events[0].read), (100.0, 90.0));
+    assert!((events[1].truth - 0.8).abs() < 1e-12);
+    assert!((events[1].read - 0.8).abs() < 0.05 && events[1].read != 0.8);
+    assert_eq!(events[1].spec.at, Some(0.8));
+    // Reproducible.
+    assert_eq!(t.generate_with_events().unwrap().1, events);
+}

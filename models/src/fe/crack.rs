@@ -61,6 +61,25 @@ fn clamp_between(v: f64, a: f64, b: f64) -> f64 {
 /// Length of `{D ≥ threshold}` plus fronts, for points at increasing `x` with damage `d`
 /// (`deficit` is scratch space of the same length).
 pub fn measure(x: &[f64], d: &[f64], threshold: f64, origin: f64, deficit: &mut [f64]) -> CrackMeasures {
+    measure_located(x, d, threshold, origin, deficit, |_, _| None)
+}
+
+/// As [`measure`], with the debonded fronts placed by `located(inside, outside)`: the position
+/// (mm) of the front between the debonded point `inside` and its neighbour `outside` (below the
+/// threshold), e.g. where the law, evaluated along the gap interpolated between the two points,
+/// reaches the threshold ([`super::segment::level_front`]). Such a front moves continuously with
+/// the points' gaps: it leaves a point exactly when that point reaches the threshold and crosses
+/// the element as the gaps grow, so the debonded length is a continuous function of the state
+/// (and of the parameters) instead of growing by whole points. Where `located` gives `None` the
+/// front is extrapolated as in [`measure`].
+pub fn measure_located(
+    x: &[f64],
+    d: &[f64],
+    threshold: f64,
+    origin: f64,
+    deficit: &mut [f64],
+    located: impl Fn(usize, usize) -> Option<f64>,
+) -> CrackMeasures {
     let n = x.len();
     let mut m = CrackMeasures { tip: origin, ..Default::default() };
     if n == 0 {
@@ -82,12 +101,19 @@ pub fn measure(x: &[f64], d: &[f64], threshold: f64, origin: f64, deficit: &mut 
             i += 1;
         }
         let end = i;
-        let left =
-            if start == 0 { x[0] } else { front_from_outside(x, deficit, start, start - 1, start.checked_sub(2), et) };
+        let left = if start == 0 {
+            x[0]
+        } else {
+            located(start, start - 1)
+                .map(|f| clamp_between(f, x[start], x[start - 1]))
+                .unwrap_or_else(|| front_from_outside(x, deficit, start, start - 1, start.checked_sub(2), et))
+        };
         let right = if end + 1 == n {
             x[n - 1]
         } else {
-            front_from_outside(x, deficit, end, end + 1, (end + 2 < n).then_some(end + 2), et)
+            located(end, end + 1)
+                .map(|f| clamp_between(f, x[end], x[end + 1]))
+                .unwrap_or_else(|| front_from_outside(x, deficit, end, end + 1, (end + 2 < n).then_some(end + 2), et))
         };
         m.debonded += right - left;
         m.tip = m.tip.max(right);

@@ -54,6 +54,7 @@ use super::fibre::{self, FibreSection};
 use super::interface::{self, InterfacePoint, PointKind};
 use super::mesh::{Mesh, NONE};
 use super::newton::NewtonSettings;
+use super::segment;
 use crate::materials::UniaxialState;
 
 /// Fraction of the initial normal stiffness a failed interface point keeps in opening under
@@ -950,7 +951,19 @@ pub fn run(
         for (d, st) in dmg.iter_mut().zip(&h.points) {
             *d = st.damage;
         }
-        let crack = crack::measure(&xs, &dmg, path.damage_threshold, xs.first().copied().unwrap_or(0.0), &mut scratch);
+        // Debonded fronts inside the elements, where the law along the gap interpolated between
+        // a debonded point and its neighbour reaches the threshold (see `crack::measure_located`).
+        // Where it does not reach it even at the debonded point (that point has unloaded since it
+        // failed), the front is at the point: the located front slides there continuously as the
+        // point unloads.
+        let located = |inside: usize, outside: usize| {
+            let (gi, go) = (h.law_gaps[inside], h.law_gaps[outside]);
+            let (si, so) = (&h.points[inside], &h.points[outside]);
+            let eta = segment::level_front(law, gi, go, si, so, path.damage_threshold).unwrap_or(0.0);
+            Some(xs[inside] + eta * (xs[outside] - xs[inside]))
+        };
+        let origin = xs.first().copied().unwrap_or(0.0);
+        let crack = crack::measure_located(&xs, &dmg, path.damage_threshold, origin, &mut scratch, located);
         let row = NonlinearRow {
             control: control(q) - c0,
             load,

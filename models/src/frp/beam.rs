@@ -62,7 +62,10 @@
 //!
 //! `displacement` is the **mid-span deflection** (mm, downward positive), `load` the total load `P`
 //! on the beam (N). `debonded_length` is the length of the modelled side's interface with damage at
-//! or above `control.damage_threshold` (default `1 − 10⁻⁹`: the bond has no stress left), and
+//! or above `control.damage_threshold` (default `1 − 10⁻⁹`: the bond has no stress left), its
+//! fronts located inside the elements where the law, along the gaps interpolated between the last
+//! failed point and the next, reaches that threshold (so the length is continuous in the state
+//! and in the law's parameters instead of growing by whole points, [`crate::fe::crack`]), and
 //! `process_zone_length` the length with `0 < D <` threshold; `crack_tip` the debonded front
 //! farthest from mid-span (mm from mid-span). Energies are the whole beam's (N·mm): external work
 //! = elastic + dissipated, where `dissipated_energy` is the interface's plus the concrete's and the

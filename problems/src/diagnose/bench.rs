@@ -299,6 +299,8 @@ fn synthetic_experiment(
         debonded_length: Some(Curve::new(data.displacement, data.debonded_length)?),
         initial_crack: None,
         dropped: Default::default(),
+        events: Vec::new(),
+        ordinate: Default::default(),
     })
 }
 

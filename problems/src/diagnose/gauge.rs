@@ -74,6 +74,12 @@ impl Gauge {
     pub fn new(experiments: &[Experiment], use_length: bool, noise_levels: NoiseLevels) -> Result<Self> {
         let mut blocks = Vec::new();
         for e in experiments {
+            if e.ordinate != crate::data::Ordinate::Load {
+                return Err(CzError::config(
+                    format!("experiment `{}`", e.name),
+                    "the diagnosis compares load curves; this one is a moment (`ordinate`)",
+                ));
+            }
             let (x, y) = (e.load.x().to_vec(), e.load.y().to_vec());
             let sigma = noise_levels.load.unwrap_or_else(|| noise::estimate(&x, &y, false));
             blocks.push(Block {
@@ -149,9 +155,16 @@ impl Gauge {
         out
     }
 
+    /// The curve a block compares (blocks are curves: loads and debonded lengths).
+    fn curve(block: &Block) -> Result<czid_core::ColumnResponse> {
+        block.term.response().ok_or_else(|| {
+            CzError::config(format!("experiment `{}`", block.experiment), "the diagnosis compares curves, not events")
+        })
+    }
+
     /// Model value of a block's response at its readings.
     pub fn model_values(block: &Block, record: &Record) -> Result<Vec<f64>> {
-        block.term.response().predict(record, &block.x)
+        Self::curve(block)?.predict(record, &block.x)
     }
 
     /// The experiments the gauge measures, in block order (each once).
@@ -168,7 +181,7 @@ impl Gauge {
             let record = records
                 .get(&b.experiment)
                 .ok_or_else(|| CzError::config(format!("experiment `{}`", b.experiment), "has no simulation record"))?;
-            r.extend(scaled_residuals(&b.term.response(), record, &b.x, &b.y, b.sigma)?);
+            r.extend(scaled_residuals(&Self::curve(b)?, record, &b.x, &b.y, b.sigma)?);
         }
         Ok(r)
     }

@@ -38,7 +38,7 @@ fn plots(d: &Diagnosis, out: &OutputDir) -> Result<Vec<String>> {
         fig.save(&out.file(&name))?;
         files.push(name);
 
-        let column = b.term.column();
+        let Some(column) = b.term.column() else { continue };
         let accounted = d.model_form.applied();
         let mut fit =
             Figure::new(&format!("{}: {what}", b.experiment), "displacement (mm)", &format!("{what} ({unit})")).with(
