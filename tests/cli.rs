@@ -36,14 +36,22 @@ fn every_bundled_problem_file_loads() {
         "examples/hartlen-joint/dcb-enf-stczm.toml",
         "examples/frp-pull/problem.toml",
         "examples/frp-beam/identify.toml",
+        "examples/frp-beam/joint.toml",
+        "examples/mixed-mode-synthetic/problem.toml",
     ] {
         let p = czid_problems::problem_file::LoadedProblem::read(&root.join(file))
             .unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(!p.experiments.is_empty(), "{file}");
     }
-    for truth in
-        ["examples/paper-dcb/truth.toml", "examples/frp-pull/truth.toml", "examples/frp-beam/identify/truth.toml"]
-    {
+    for truth in [
+        "examples/paper-dcb/truth.toml",
+        "examples/frp-pull/truth.toml",
+        "examples/frp-beam/identify/truth.toml",
+        "examples/frp-beam/joint/pull-truth.toml",
+        "examples/mixed-mode-synthetic/truth-dcb.toml",
+        "examples/mixed-mode-synthetic/truth-enf.toml",
+        "examples/mixed-mode-synthetic/truth-mmb.toml",
+    ] {
         czid_problems::synthetic::TruthFile::read(&root.join(truth)).unwrap_or_else(|e| panic!("{truth}: {e}"));
     }
 }
