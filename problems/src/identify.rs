@@ -529,8 +529,11 @@ pub(crate) fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &Outpu
         }
         out.write_csv(&format!("{stem}{suffix}.csv"), &header, &cols)?;
 
-        let sim = record.curve(columns::DISPLACEMENT, columns::LOAD)?;
-        Figure::new(&format!("{}: load", e.name), "displacement (mm)", "load (N)")
+        // The curve the experiment is fitted on: the load, or the beam's mid-span moment.
+        let (column, unit) = (e.ordinate.column(), e.ordinate.unit());
+        let sim = record.curve(columns::DISPLACEMENT, column)?;
+        let label = column.replace('_', " ");
+        Figure::new(&format!("{}: {label}", e.name), "displacement (mm)", &format!("{label} ({unit})"))
             .with(Series::points("test", e.load.x().to_vec(), e.load.y().to_vec()))
             .with(Series::line("model", sim.x().to_vec(), sim.y().to_vec()))
             .save(&out.file(&format!("{stem}{suffix}-load.png")))?;
