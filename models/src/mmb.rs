@@ -25,7 +25,7 @@
 //! `½ C_lever P²` from the recorded energies: the record is that of a rigid lever. The lever's
 //! weight (which ASTM D6671 corrects for) is not modelled: the recorded load is the applied force.
 
-use czid_core::{CohesiveLaw, CzError, ForwardModel, Record, Result, SimulationFailure};
+use czid_core::{CohesiveLaw, ForwardModel, Record, Result, SimulationFailure};
 use serde::{Deserialize, Serialize};
 
 use crate::beamtest::{self, ControlSettings, Material, MeshSettings, RowScale};
@@ -59,7 +59,7 @@ pub struct Mmb {
     #[serde(default)]
     pub mesh: MeshSettings,
     /// Loading and output; `control.max_displacement` is the final lever load-point displacement
-    /// (mm), by default twice the beam-theory displacement at the onset of propagation.
+    /// (mm), by default the one [`Mmb::max_displacement`] chooses from beam theory.
     #[serde(default)]
     pub control: ControlSettings,
     /// Optional physics (all off by default; `large_rotation` is not supported for MMB).
@@ -68,6 +68,10 @@ pub struct Mmb {
 }
 
 const OWNER: &str = "model mmb";
+
+/// What a run of the engine gives: the specimen's rows and the statistics, or the failure with
+/// the rows that converged.
+pub type EngineRun = std::result::Result<(Vec<StepRow>, fe::RunStats), fe::PathFailure>;
 
 /// Whole-mesh solve with segment integration, records on the output grid (the window does not
 /// apply: the specimen is supported and loaded away from its cracked end, and has contact).
@@ -148,11 +152,25 @@ impl Mmb {
     /// two clamped Timoshenko arms), `C_ENF = (3a³ + 2L³)/(8 E b h³) + 3L/(10 G13 b h)`.
     pub fn beam_compliance(&self, a: f64) -> f64 {
         let g = self.effects.shear_modulus(self.material.g13);
-        let (e, b, h, l) = (self.material.axial_modulus(), self.width, self.h, self.half_span);
+        let (e, b, h) = (self.material.axial_modulus(), self.width, self.h);
         let c_dcb = 8.0 * a.powi(3) / (e * b * h.powi(3)) + 12.0 * a / (5.0 * g * b * h);
-        let c_enf = (3.0 * a.powi(3) + 2.0 * l.powi(3)) / (8.0 * e * b * h.powi(3)) + 3.0 * l / (10.0 * g * b * h);
         let (pi, pii) = self.load_split();
-        pi * pi * c_dcb + pii * pii * c_enf
+        pi * pi * c_dcb + pii * pii * self.enf_part().beam_compliance(a)
+    }
+
+    /// The ENF the lever's shear part loads: the same specimen and crack without the lever.
+    fn enf_part(&self) -> crate::enf::Enf {
+        crate::enf::Enf {
+            a0: self.a0,
+            half_span: self.half_span,
+            width: self.width,
+            h: self.h,
+            material: self.material.clone(),
+            contact_stiffness: self.contact_stiffness,
+            mesh: self.mesh.clone(),
+            control: self.control.clone(),
+            effects: self.effects.clone(),
+        }
     }
 
     /// Final displacement: configured, or 1.1 times the larger beam-theory displacement on the
@@ -240,6 +258,11 @@ impl Mmb {
 
     /// Builds the discrete problem and the scaling of its rows (built per run, like the DCB's).
     pub fn problem(&self, law: &dyn CohesiveLaw) -> Result<(FeProblem, RowScale)> {
+        self.build(law).map(|(p, scale, _)| (p, scale))
+    }
+
+    /// [`Mmb::problem`] and the compliance of the lever's springs in it (mm/N).
+    fn build(&self, law: &dyn CohesiveLaw) -> Result<(FeProblem, RowScale, f64)> {
         self.validate()?;
         let fx = &self.effects;
         let (a, l, c) = (self.effective_crack_length(), self.half_span, self.lever);
@@ -279,25 +302,25 @@ impl Mmb {
             crate::measurement::LoadPoint { dof: u(mid), per_unit: -1.0, share: 1.0, at_first_node: false };
         let (control, mut scale) =
             crate::measurement::recorded_control(fx.machine_compliance, fx.readout(), load_point, &mut springs);
-        scale.compliance -= self.tie_compliance(mid);
+        let lever_compliance = self.tie_compliance(mid);
+        scale.compliance -= lever_compliance;
         let contact_stiffness = self.contact_stiffness.unwrap_or(law.initial_stiffness()[0]);
         let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: false, contact_stiffness };
-        Ok((p, scale))
+        Ok((p, scale, lever_compliance))
     }
 
     /// The path in the control unknown, which also moves with the lever's own compliance: to
     /// record the specimen up to `max_displacement` it runs further by `C_lever P_c` (`P_c` the
     /// beam-theory onset load), so the record ends at, or a little beyond, `max_displacement`.
-    fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
+    fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale, lever_compliance: f64) -> PathSettings {
         let a = self.effective_crack_length();
-        let lever = self.lever_compliance() * self.onset_load(law);
+        let lever = lever_compliance * self.onset_load(law);
         self.control.path((self.max_displacement(law) + lever) / scale.displacement, a)
     }
 
     /// Engine rows with the lever's stored energy `½ C_lever P²` taken out of the external work and
     /// the elastic energy (the specimen's energies).
-    fn specimen_rows(&self, rows: &[StepRow]) -> Vec<StepRow> {
-        let cl = self.lever_compliance();
+    fn specimen_rows(rows: &[StepRow], cl: f64) -> Vec<StepRow> {
         rows.iter()
             .map(|r| {
                 let lever = 0.5 * cl * r.reaction * r.reaction;
@@ -310,15 +333,24 @@ impl Mmb {
     /// unknown being the lever's load point in the mesh's sign convention) and statistics; for
     /// checks of the engine's quantities, such as the interface's work by mode
     /// ([`StepRow::shear_work`]).
-    pub fn run_rows(
-        &self,
-        law: &dyn CohesiveLaw,
-    ) -> std::result::Result<(Vec<StepRow>, fe::RunStats), fe::PathFailure> {
-        let fail = |error: CzError| fe::PathFailure { error, rows: Vec::new() };
-        law.validate().map_err(fail)?;
-        let (p, scale) = self.problem(law).map_err(fail)?;
-        let path = self.path(law, &scale);
-        fe::run_with(&p, law, &path, &RUN).map(|(rows, stats)| (self.specimen_rows(&rows), stats))
+    pub fn run_rows(&self, law: &dyn CohesiveLaw) -> EngineRun {
+        self.run(law).1
+    }
+
+    /// Builds the problem once and runs it: the scaling of its rows (`None` when the problem could
+    /// not be built), and the specimen's rows and statistics, or on failure its converged rows.
+    fn run(&self, law: &dyn CohesiveLaw) -> (Option<RowScale>, EngineRun) {
+        let built = law.validate().and_then(|_| self.build(law));
+        let (p, scale, cl) = match built {
+            Ok(b) => b,
+            Err(error) => return (None, Err(fe::PathFailure { error, rows: Vec::new() })),
+        };
+        let path = self.path(law, &scale, cl);
+        let run = match fe::run_with(&p, law, &path, &RUN) {
+            Ok((rows, stats)) => Ok((Self::specimen_rows(&rows, cl), stats)),
+            Err(f) => Err(fe::PathFailure { error: f.error, rows: Self::specimen_rows(&f.rows, cl) }),
+        };
+        (Some(scale), run)
     }
 }
 
@@ -338,15 +370,13 @@ impl ForwardModel for Mmb {
     }
 
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
-        let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
-        law.validate().map_err(fail)?;
-        let (_, scale) = self.problem(law).map_err(fail)?;
-        match self.run_rows(law) {
-            Ok((rows, _)) => Ok(beamtest::to_record(&rows, &scale)),
-            Err(f) => Err(SimulationFailure {
-                error: f.error,
-                partial: beamtest::to_record(&self.specimen_rows(&f.rows), &scale),
-            }),
+        let (scale, run) = self.run(law);
+        // Without a built problem there are no rows: the record is empty either way.
+        let record =
+            |rows: &[StepRow]| scale.as_ref().map_or_else(beamtest::new_record, |s| beamtest::to_record(rows, s));
+        match run {
+            Ok((rows, _)) => Ok(record(&rows)),
+            Err(f) => Err(SimulationFailure { partial: record(&f.rows), error: f.error }),
         }
     }
 }
