@@ -1,6 +1,6 @@
 //! Responses: what of a simulation is compared with a test, reading by reading.
 
-use crate::error::{CzError, Result};
+use crate::error::Result;
 use crate::record::Record;
 use serde::{Deserialize, Serialize};
 
@@ -89,12 +89,7 @@ impl Response for AtPeak {
     }
 
     fn predict(&self, record: &Record, at: &[f64]) -> Result<Vec<f64>> {
-        let peak = record.column(&self.peak)?;
-        let value = record.column(&self.value)?;
-        let i =
-            (0..peak.len()).filter(|&i| peak[i].is_finite()).max_by(|&a, &b| peak[a].total_cmp(&peak[b])).ok_or_else(
-                || CzError::data(format!("response `{}`", self.value), format!("no finite `{}` in the run", self.peak)),
-            )?;
-        Ok(vec![value[i]; at.len()])
+        let (i, _) = crate::event::largest(record, &self.peak, &self.value)?;
+        Ok(vec![record.column(&self.value)?[i]; at.len()])
     }
 }

@@ -66,7 +66,16 @@ impl Response for OnsetOfDebonding {
     fn predict(&self, record: &Record, at: &[f64]) -> Result<Vec<f64>> {
         let (_, peak) = largest(record, columns::LOAD, self.name())?;
         let (p, l) = (record.column(columns::LOAD)?, record.column(columns::DEBONDED_LENGTH)?);
-        let value = first_reaching(p, self.fraction * peak, l).expect("the peak load is reached");
+        // A load that is negative at its largest never rises to a fraction of it.
+        let value = first_reaching(p, self.fraction * peak, l).ok_or_else(|| {
+            CzError::data(
+                format!("response `{}`", self.name()),
+                format!(
+                    "the load never reaches {} of its largest value {peak} (a positive load is expected)",
+                    self.fraction
+                ),
+            )
+        })?;
         Ok(vec![value; at.len()])
     }
 }
@@ -74,6 +83,15 @@ impl Response for OnsetOfDebonding {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_load_that_never_rises_to_the_fraction_is_an_error_not_a_panic() {
+        let mut r = Record::new(&[(columns::LOAD, "N"), (columns::DEBONDED_LENGTH, "mm")]);
+        r.push(&[-10.0, 0.0]);
+        r.push(&[-20.0, 1.0]);
+        let e = OnsetOfDebonding::default().predict(&r, &[0.0]).unwrap_err().to_string();
+        assert!(e.contains("never reaches"), "{e}");
+    }
 
     #[test]
     fn the_fraction_must_lie_in_zero_one() {
