@@ -346,3 +346,21 @@ fn a_held_out_specimen_is_predicted_at_the_values_calibrated_on_the_others() {
     std::fs::remove_dir_all(&pred).ok();
     assert!(!Path::new("unused").exists());
 }
+
+#[test]
+fn a_problem_with_events_plots_them_test_beside_model() {
+    let out = scratch("events");
+    let o = out.to_str().unwrap();
+    let r = czid(&["simulate", "examples/frp-beam/identify.toml", "--out", o]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    // The beam's two debonded lengths (mm); it has no load event, so no load-event figure.
+    assert!(out.join("curves-events.png").exists());
+    assert!(!out.join("curves-events-load.png").exists());
+    // A problem without events draws none.
+    let dcb = scratch("no-events");
+    let r = czid(&["simulate", "examples/paper-dcb/truth.toml", "--out", dcb.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert!(!dcb.join("curves-events.png").exists());
+    std::fs::remove_dir_all(&out).ok();
+    std::fs::remove_dir_all(&dcb).ok();
+}

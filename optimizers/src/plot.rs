@@ -201,6 +201,11 @@ impl Figure {
         if !yr.0.is_finite() {
             yr = if self.log_y { (1e-3, 1.0) } else { (0.0, 1.0) };
         }
+        if !self.categories.is_empty() {
+            // Half a category of room on either side, so that the first and last columns and
+            // their names are not cut by the frame.
+            xr = (0.5, self.categories.len() as f64 + 0.5);
+        }
         if xr.1 <= xr.0 {
             xr.1 = xr.0 + 1.0;
         }
@@ -295,7 +300,9 @@ impl Figure {
                 Mark::Line => chart.draw_series(LineSeries::new(pts, style)).map_err(err)?,
                 Mark::Dashed => chart.draw_series(DashedLineSeries::new(pts, 8, 5, style)).map_err(err)?,
                 Mark::Points => {
-                    chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 2, color.filled()))).map_err(err)?
+                    // Few points per column on a categorical axis: larger marks.
+                    let r = if self.categories.is_empty() { 2 } else { 5 };
+                    chart.draw_series(pts.into_iter().map(|p| Circle::new(p, r, color.filled()))).map_err(err)?
                 }
             };
             anno.label(s.label.clone()).legend(move |(x, y)| {

@@ -544,6 +544,36 @@ pub(crate) fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &Outpu
                 .with(Series::line("model", sim.x().to_vec(), sim.y().to_vec()))
                 .save(&out.file(&format!("{stem}{suffix}-debonded.png")))?;
         }
+        events_plot(e, record, out, &format!("{stem}{suffix}"))?;
+    }
+    Ok(())
+}
+
+/// The experiment's scalar events, test beside model, one figure per unit (`-events.png` for
+/// lengths and displacements in mm, `-events-load.png` for loads in N); nothing without events.
+fn events_plot(e: &crate::data::Experiment, record: &czid_core::Record, out: &OutputDir, stem: &str) -> Result<()> {
+    for (unit, file) in [("mm", "events"), ("N", "events-load")] {
+        let mine: Vec<_> = e.events.iter().filter(|v| v.unit() == unit).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let names: Vec<String> = mine.iter().map(|v| v.name.clone()).collect();
+        let at: Vec<f64> = (1..=mine.len()).map(|i| i as f64).collect();
+        let test: Vec<f64> = mine.iter().map(|v| v.value).collect();
+        // An event the model does not reach (a run that stopped early) is left out of the model's
+        // points rather than drawn at a made-up value.
+        let (model_at, model): (Vec<f64>, Vec<f64>) = mine
+            .iter()
+            .zip(&at)
+            .filter_map(|(v, &x)| {
+                v.response.boxed().predict(record, &[0.0]).ok().and_then(|p| p.first().map(|&y| (x, y)))
+            })
+            .unzip();
+        Figure::new(&format!("{}: events", e.name), "event", &format!("value ({unit})"))
+            .with(Series::points("test", at, test))
+            .with(Series::points("model", model_at, model))
+            .with_categories(&names)
+            .save(&out.file(&format!("{stem}-{file}.png")))?;
     }
     Ok(())
 }
