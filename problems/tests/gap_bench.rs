@@ -88,3 +88,29 @@ fn continuum_truth_makes_the_tests_with_the_continuum_model_and_keeps_its_cases_
     assert!(names.iter().all(|n| n.contains("-continuum-")), "{names:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn dcb_cases_alternate_between_two_specimens_and_fit_the_law_with_the_modulus_known() {
+    use bench::Specimen;
+    use rand::SeedableRng;
+    let space = Family::Dcb.space();
+    let fitted: Vec<&str> = space.parameters().iter().map(|p| p.path.as_str()).collect();
+    assert_eq!(fitted, ["law.strength_n", "law.g_ic"]);
+    for index in 0..4 {
+        let draw = Family::Dcb.draw(index, &mut rand_chacha::ChaCha8Rng::seed_from_u64(index as u64));
+        let (specimen, modulus) = if index % 2 == 0 {
+            (Specimen::HartlenDcb, 16_000.0..30_000.0)
+        } else {
+            (Specimen::PaperDcb, 115_000.0..145_000.0)
+        };
+        assert_eq!(draw.specimen, specimen);
+        assert!(modulus.contains(&draw.truth[2]), "case {index}: {}", draw.truth[2]);
+        // The base model is the specimen's, at the drawn (known) modulus, run to the drawn end.
+        let setup = Family::Dcb.base_setup(&draw).unwrap();
+        let model = serde_json::to_value(setup.models["dcb"].as_ref()).unwrap();
+        let (width, a0) = if index % 2 == 0 { (25.0, 37.64) } else { (20.0, 50.0) };
+        assert_eq!((model["width"].as_f64(), model["a0"].as_f64()), (Some(width), Some(a0)));
+        assert_eq!(model["material"]["e11"].as_f64(), Some(draw.truth[2]));
+        assert_eq!(model["control"]["max_displacement"].as_f64(), draw.end);
+    }
+}

@@ -27,7 +27,8 @@ pub struct GapBenchArgs {
     /// Effects to plant, comma separated (default: every bundled candidate of the family).
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
-    /// Synthetic tests: `dcb` (Hartlen's specimens) or `beam` (the paper's FRP-strengthened beam).
+    /// Synthetic tests: `dcb` (Hartlen's and the paper's DCB specimens, one case in two each; the
+    /// arm modulus known, strength and toughness fitted) or `beam` (the paper's FRP-strengthened beam).
     #[arg(long, default_value = "dcb")]
     pub family: String,
     /// Model that makes the synthetic tests: `beam` (the diagnosed model itself) or `continuum`

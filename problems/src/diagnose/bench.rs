@@ -9,7 +9,7 @@
 mod family;
 mod truth;
 
-pub use family::{Family, TestDraw};
+pub use family::{Family, Specimen, TestDraw};
 pub use truth::Truth;
 
 use crate::data::Experiment;
@@ -63,9 +63,13 @@ pub struct CaseResult {
     pub index: usize,
     /// Planted effect ([`NONE`] for a null case).
     pub planted: String,
+    /// The specimen ([`Specimen::name`]).
+    #[serde(default)]
+    pub specimen: String,
     /// Its values (physical units, per parameter).
     pub size: Vec<f64>,
-    /// True values of the fitted parameters (physical units, in the order of [`Family::space`]).
+    /// True values of the fitted parameters (physical units, in the order of [`Family::space`]),
+    /// then the known modulus (MPa).
     pub truth: [f64; 3],
     /// Load (N) and crack-length (mm) noise.
     pub noise: [f64; 2],
@@ -100,6 +104,12 @@ pub struct CaseResult {
     pub base_fit: Vec<f64>,
     /// χ²/dof of the base fit.
     pub base_reduced_chi2: f64,
+    /// Probability of the structure left in the base fit's residuals under white noise.
+    #[serde(default)]
+    pub base_structure_p: f64,
+    /// The same for the named cause's refit (`None` without a cause).
+    #[serde(default)]
+    pub cause_structure_p: Option<f64>,
     /// RMS of the model-form shift accounted for (noise units; 0 when it was not).
     #[serde(default)]
     pub model_form_shift_rms: f64,
@@ -168,7 +178,8 @@ fn case(
 ) -> CaseResult {
     let clock = std::time::Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
-    let TestDraw { truth, noise, readings, end } = family.draw(&mut rng);
+    let draw = family.draw(index, &mut rng);
+    let TestDraw { specimen, truth, noise, readings, end } = draw.clone();
     let mut size = if planted == GAIN {
         vec![rng.random_range(GAIN_RANGE)]
     } else {
@@ -179,6 +190,7 @@ fn case(
     let mut out = CaseResult {
         index,
         planted: planted.into(),
+        specimen: specimen.name().into(),
         size: size.clone(),
         truth,
         noise,
@@ -194,6 +206,8 @@ fn case(
         ranking: Vec::new(),
         base_fit: Vec::new(),
         base_reduced_chi2: f64::NAN,
+        base_structure_p: f64::NAN,
+        cause_structure_p: None,
         model_form_shift_rms: 0.0,
         base_reduced_chi2_as_measured: f64::NAN,
         base_at_noise_level: false,
@@ -207,7 +221,7 @@ fn case(
         error: None,
     };
     let mut run = || -> Result<()> {
-        let base = family.base_setup(&truth, end)?;
+        let base = family.base_setup(&draw)?;
         let record = planted_record(&base, effect, (family, made_by), &mut size, &mut rng, &mut out)?;
         // Without a set end the test is read up to a share of the deflection at its peak load.
         let end = match end {
@@ -314,6 +328,13 @@ fn with_gain(e: Experiment, g: f64) -> Result<Experiment> {
 /// effect's refit, failures and the candidates' angles.
 fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
     out.base_reduced_chi2 = d.base.reduced_chi2;
+    out.base_structure_p = d.base.structure_p;
+    out.cause_structure_p = d
+        .outcome
+        .cause
+        .as_ref()
+        .and_then(|c| d.candidates.iter().find(|x| &x.name == c))
+        .and_then(|x| x.refit.as_ref().map(|r| r.structure_p));
     out.model_form_shift_rms = d.model_form.shift_rms;
     out.base_reduced_chi2_as_measured =
         d.base.reduced_chi2 * d.model_form.chi2_as_measured / d.base.chi2.max(f64::MIN_POSITIVE);
@@ -384,7 +405,7 @@ impl Plan {
         let family = opts.family;
         opts.truth.check(family)?;
         // Every candidate that applies to the family's model and that it knows how to plant.
-        let sample = family.base_setup(&family.draw(&mut ChaCha8Rng::seed_from_u64(0)).truth, None)?;
+        let sample = family.base_setup(&TestDraw { end: None, ..family.draw(0, &mut ChaCha8Rng::seed_from_u64(0)) })?;
         let offered = library.names(&sample);
         let gain = family == Family::Dcb && (opts.effects.is_empty() || opts.effects.iter().any(|e| e == GAIN));
         let asked: Vec<String> = opts.effects.iter().filter(|e| *e != GAIN).cloned().collect();
@@ -624,6 +645,25 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
             seen.len(),
             mine.len()
         );
+    }
+    // Right verdicts by specimen, for a family of several.
+    let mut specimens: Vec<&str> = r.cases.iter().map(|c| c.specimen.as_str()).collect();
+    specimens.sort_unstable();
+    specimens.dedup();
+    if specimens.len() > 1 {
+        let _ = writeln!(s, "\nRight verdicts by specimen:\n\n| effect | {} |", specimens.join(" | "));
+        let _ = writeln!(s, "|---|{}", "---|".repeat(specimens.len()));
+        for e in r.labels.iter() {
+            let cells: Vec<String> = specimens
+                .iter()
+                .map(|sp| {
+                    let mine: Vec<&CaseResult> =
+                        r.cases.iter().filter(|c| &c.planted == e && c.specimen == *sp).collect();
+                    format!("{}/{}", mine.iter().filter(|c| right(c)).count(), mine.len())
+                })
+                .collect();
+            let _ = writeln!(s, "| {e} | {} |", cells.join(" | "));
+        }
     }
     // Confusions actually observed: a fifth or more of an effect's cases named as another.
     let _ = writeln!(s, "\nObserved confusions (≥ 20 % of an effect's cases diagnosed as another):\n");

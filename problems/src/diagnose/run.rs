@@ -124,6 +124,9 @@ pub struct BaseFit {
     pub p_value: f64,
     /// Whether the misfit is consistent with the noise alone.
     pub at_noise_level: bool,
+    /// Probability of the structure in its residuals under white noise
+    /// ([`crate::diagnose::stats::structure_p`]).
+    pub structure_p: f64,
     /// Residual evaluations of the fit (after the file's optimizer, if run).
     pub evaluations: usize,
     /// Runs that stopped early at the fit.
@@ -175,6 +178,10 @@ pub struct Refit {
     /// refit polished on it (the named cause only, when the floor applies): what "more is
     /// missing" is judged on.
     pub chi2_reestimated: Option<f64>,
+    /// Probability of the structure left in the refit's residuals under white noise
+    /// ([`crate::diagnose::stats::structure_p`]; on the re-estimated floor when there is one):
+    /// below the noise level, more is missing even when the χ² of all readings cannot tell.
+    pub structure_p: f64,
 }
 
 /// Prediction of withheld data with and without the effect.
@@ -416,6 +423,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         reduced_chi2: base.chi2 / base.dof as f64,
         p_value: base.p_noise,
         at_noise_level: base.p_noise > NOISE_LEVEL,
+        structure_p: crate::diagnose::stats::structure_p(&base.misfit.r, &base.gauge.ranges()),
         evaluations: base.evaluations,
         failures: base.misfit.failures.clone(),
         at_bound: base::at_bound(&base.u).into_iter().map(|j| base.space.parameters()[j].path.clone()).collect(),
@@ -426,9 +434,12 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         // truth; the cause's refit is judged again with the floor re-estimated at its parameters.
         if let Some((c, params, out)) = refits.get(cause) {
             say(&format!("{cause}: the model-form floor re-estimated at its refit"));
-            let chi2 = reestimated(&base, &measured, c.as_ref(), params, out)?;
+            let again = reestimated(&base, &measured, c.as_ref(), params, out)?;
             if let Some(r) = candidates.iter_mut().find(|x| &x.name == cause).and_then(|x| x.refit.as_mut()) {
-                r.chi2_reestimated = chi2;
+                if let Some((chi2, structure)) = again {
+                    r.chi2_reestimated = Some(chi2);
+                    r.structure_p = structure;
+                }
             }
         }
     }
@@ -472,19 +483,22 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
 }
 
 /// χ² of candidate `c`'s refit `out` polished again on the measured data shifted by the model-form
-/// misfit at the refit's fitted parameters (`None` when that cannot be estimated or the polish
-/// fails).
+/// misfit at the refit's fitted parameters, and the structure left in its residuals (`None` when
+/// that cannot be estimated or the polish fails).
 fn reestimated(
     base: &base::Base,
     measured: &Gauge,
     c: &dyn crate::diagnose::CandidateEffect,
     params: &[Parameter],
     out: &refit::RefitOutcome,
-) -> Result<Option<f64>> {
+) -> Result<Option<(f64, f64)>> {
     let p = base.space.dim();
     let fitted = base.space.apply(&base.setup, &base.space.from_unit(&out.v[..p]))?;
     let Some(gauge) = model_form::account_at(measured, &fitted)? else { return Ok(None) };
-    Ok(refit::refit_on(&gauge, base, c, params, &out.v, out.jacobian.clone()).ok().map(|o| o.misfit.rss()))
+    let ranges = gauge.ranges();
+    Ok(refit::refit_on(&gauge, base, c, params, &out.v, out.jacobian.clone())
+        .ok()
+        .map(|o| (o.misfit.rss(), crate::diagnose::stats::structure_p(&o.misfit.r, &ranges))))
 }
 
 /// A refitted candidate: the effect, its parameters and the refit.

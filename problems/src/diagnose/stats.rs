@@ -1,4 +1,34 @@
-//! χ² tail probabilities (regularised upper incomplete gamma function, Numerical Recipes §6.2).
+//! χ² tail probabilities (regularised upper incomplete gamma function, Numerical Recipes §6.2),
+//! and a test for structure left in residuals.
+
+/// Readings per bin of [`structure_p`]: long enough to average white noise down, short enough
+/// (30–50 bins on a curve of 300–500 readings) to follow a misfit that changes along the curve.
+pub const STRUCTURE_BIN: usize = 10;
+
+/// Probability that residuals `r` (noise units, white noise under the null), cut into
+/// `ranges` (one per curve, readings in curve order), show at least the structure they show:
+/// the sums of consecutive bins of [`STRUCTURE_BIN`] readings, squared and divided by the bin
+/// length, are `χ²(1)` each under white noise, and a smooth misfit adds to every bin of its
+/// stretch. A misfit spread thinly over many readings (χ²/dof of 1.1 over 700 readings, which the
+/// χ² of all readings cannot tell from noise) is plain here: binning keeps the misfit and divides
+/// the noise's share by the bin length. A tail bin shorter than half a bin is left out.
+pub fn structure_p(r: &[f64], ranges: &[std::ops::Range<usize>]) -> f64 {
+    let (mut stat, mut bins) = (0.0, 0usize);
+    for range in ranges {
+        for bin in r[range.clone()].chunks(STRUCTURE_BIN) {
+            if 2 * bin.len() < STRUCTURE_BIN {
+                continue;
+            }
+            let sum: f64 = bin.iter().sum();
+            stat += sum * sum / bin.len() as f64;
+            bins += 1;
+        }
+    }
+    if bins == 0 {
+        return 1.0;
+    }
+    chi2_survival(stat, bins as f64)
+}
 
 /// `P(X > x)` for `X ~ χ²(k)`.
 pub fn chi2_survival(x: f64, k: f64) -> f64 {
@@ -85,5 +115,46 @@ mod tests {
         }
         // Closed form for two degrees of freedom: exp(−x/2).
         assert!((chi2_survival(7.0, 2.0) - (-3.5f64).exp()).abs() < 1e-14);
+    }
+
+    use rand::{Rng, SeedableRng};
+
+    /// Unit white noise (Box–Muller).
+    fn white(n: usize, seed: u64) -> Vec<f64> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                let (u, v): (f64, f64) = (1.0 - rng.random::<f64>(), rng.random());
+                (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn white_noise_shows_no_structure_and_a_thin_smooth_misfit_does() {
+        let n = 700;
+        // Under the null the p-value is uniform: over 200 draws about a fifth falls below 0.2.
+        let below: usize = (0..200).filter(|&s| structure_p(&white(n, s), &[0..n]) < 0.2).count();
+        assert!((25..=55).contains(&below), "{below} of 200 white-noise draws below p = 0.2");
+        // A smooth misfit of 0.45 noise units amplitude over the whole curve (χ²/dof about 1.1):
+        // the χ² of all readings flags it at 1e-3 in a few draws, the bins in (nearly) all.
+        let (mut by_chi2, mut by_bins) = (0, 0);
+        for seed in 0..20 {
+            let r: Vec<f64> =
+                white(n, 1000 + seed).iter().enumerate().map(|(i, e)| e + 0.45 * (i as f64 / 120.0).sin()).collect();
+            let chi2: f64 = r.iter().map(|x| x * x).sum();
+            by_chi2 += usize::from(chi2_survival(chi2, n as f64) <= 1e-3);
+            by_bins += usize::from(structure_p(&r, &[0..n]) <= 1e-3);
+        }
+        assert!(by_chi2 <= 8 && by_bins >= 19, "flagged by χ² {by_chi2}/20, by the bins {by_bins}/20");
+    }
+
+    #[test]
+    fn bins_stay_inside_their_curve() {
+        // Two curves of opposite constant misfit: bins across the boundary would cancel.
+        let r: Vec<f64> = (0..40).map(|i| if i < 20 { 1.0 } else { -1.0 }).collect();
+        let p_split = structure_p(&r, &[0..20, 20..40]);
+        assert!(p_split < 1e-6, "{p_split}");
+        assert_eq!(structure_p(&[], &[]), 1.0);
     }
 }

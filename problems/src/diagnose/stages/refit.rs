@@ -25,6 +25,12 @@ pub fn refit_options(dim: usize) -> LmOptions {
 /// Unit-cube values from which the secondary parameters of a several-parameter effect are refitted
 /// again.
 const SECONDARY_STARTS: [f64; 3] = [0.1, 0.3, 0.6];
+/// Unit-cube values of an effect's first parameter from which a refit that removed little is
+/// started again, on either side of the null (a fitted parameter at a bound can pin the first
+/// refit to its start: the steps it asks for leave the box).
+const PRIMARY_STARTS: [f64; 2] = [0.25, 0.75];
+/// A refit removing less than this share of the misfit is started again from [`PRIMARY_STARTS`].
+const STALLED: f64 = 0.1;
 /// A switched-on effect only moves the fitted parameters, whose Jacobian barely changes with it;
 /// its runs can be far dearer (large rotations), so fewer steps, a looser stop and one fresh
 /// Jacobian; the switch itself stays on.
@@ -138,7 +144,18 @@ pub fn refit(
         m.columns_mut(p, params.len()).copy_from(&sens.columns);
         m
     };
-    let mut out = refit_on(&base.gauge, base, c, &params, &start(base, c, sens, s, &params), Some(jac0))?;
+    let mut out = refit_on(&base.gauge, base, c, &params, &start(base, c, sens, s, &params), Some(jac0.clone()))?;
+    if !c.discrete() && out.misfit.rss() > (1.0 - STALLED) * base.chi2 {
+        use rayon::prelude::*;
+        let starts: Vec<Vec<f64>> = PRIMARY_STARTS
+            .into_iter()
+            .filter(|w| (out.v[p] - w).abs() >= 0.1)
+            .map(|w| base.u.iter().copied().chain(std::iter::once(w)).chain(out.v[p + 1..].iter().copied()).collect())
+            .collect();
+        let again: Vec<Result<RefitOutcome>> =
+            starts.par_iter().map(|v| refit_on(&base.gauge, base, c, &params, v, Some(jac0.clone()))).collect();
+        keep_best(&mut out, again);
+    }
     // An effect of several parameters can trade one against another along a valley (a bridging
     // tail's strength against its length): the refit is repeated from other values of every
     // parameter but the first, and the best kept.
@@ -156,16 +173,22 @@ pub fn refit(
         // Side by side (a refit runs one simulation per step); the best kept, the first of equals.
         let again: Vec<Result<RefitOutcome>> =
             starts.par_iter().map(|v| refit_on(&base.gauge, base, c, &params, v, out.jacobian.clone())).collect();
-        for o in again.into_iter().flatten() {
-            let spent = out.evaluations + o.evaluations;
-            if o.misfit.rss() < out.misfit.rss() {
-                out = RefitOutcome { evaluations: spent, ..o };
-            } else {
-                out.evaluations = spent;
-            }
-        }
+        keep_best(&mut out, again);
     }
     Ok(out)
+}
+
+/// Keeps in `out` the best of it and the refits `again` (the first of equals), counting every
+/// evaluation spent.
+fn keep_best(out: &mut RefitOutcome, again: Vec<Result<RefitOutcome>>) {
+    for o in again.into_iter().flatten() {
+        let spent = out.evaluations + o.evaluations;
+        if o.misfit.rss() < out.misfit.rss() {
+            *out = RefitOutcome { evaluations: spent, ..o };
+        } else {
+            out.evaluations = spent;
+        }
+    }
 }
 
 /// The report of a refit: fitted and effect values, χ², shrinkage overall and per regime, and
@@ -206,5 +229,6 @@ pub fn report(base: &Base, regs: &[Regime], entry: &Ranked, out: &RefitOutcome) 
         delta_bic: bic - base_bic,
         evaluations: out.evaluations,
         chi2_reestimated: None,
+        structure_p: crate::diagnose::stats::structure_p(&out.misfit.r, &base.gauge.ranges()),
     }
 }
