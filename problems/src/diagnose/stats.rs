@@ -101,6 +101,8 @@ fn gamma_q(a: f64, x: f64) -> f64 {
 }
 
 #[cfg(test)]
+// One curve is a list of one range of readings, not a range of values.
+#[allow(clippy::single_range_in_vec_init)]
 mod tests {
     use super::*;
 
