@@ -127,6 +127,9 @@ pub struct BaseFit {
     /// Probability of the structure in its residuals under white noise
     /// ([`crate::diagnose::stats::structure_p`]).
     pub structure_p: f64,
+    /// Whether the model-form floor was accounted for (the data shifted by the reference model's
+    /// difference).
+    pub model_form_accounted: bool,
     /// Residual evaluations of the fit (after the file's optimizer, if run).
     pub evaluations: usize,
     /// Runs that stopped early at the fit.
@@ -424,6 +427,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         p_value: base.p_noise,
         at_noise_level: base.p_noise > NOISE_LEVEL,
         structure_p: crate::diagnose::stats::structure_p(&base.misfit.r, &base.gauge.ranges()),
+        model_form_accounted: model_form.applied(),
         evaluations: base.evaluations,
         failures: base.misfit.failures.clone(),
         at_bound: base::at_bound(&base.u).into_iter().map(|j| base.space.parameters()[j].path.clone()).collect(),

@@ -24,7 +24,8 @@ const TRANSFER_WORSE: f64 = -0.1;
 /// model-form level. The floor is an estimate: what it leaves of the model-form misfit is smooth,
 /// and any candidate that changes the curve's shape soaks up a few per cent of it with ΔBIC well
 /// below −10 (2–6 % on clean continuum-made tests). Below this share, naming an effect would say
-/// more than the data show.
+/// more than the data show. Without a floor (a model with no reference, or `--no-model-form`)
+/// there is no such leftover, and the evidence alone decides.
 pub const MIN_SHARE_AT_NOISE: f64 = 0.1;
 
 /// What kind of answer the diagnosis gives.
@@ -90,7 +91,7 @@ pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusab
         if r.delta_bic > -EVIDENCE {
             continue;
         }
-        if base.at_noise_level && r.shrinkage < MIN_SHARE_AT_NOISE {
+        if base.model_form_accounted && base.at_noise_level && r.shrinkage < MIN_SHARE_AT_NOISE {
             reasons.push(format!(
                 "{} removes only {:.0}% of a misfit already at the noise level: not named",
                 c.name,
@@ -275,6 +276,7 @@ mod tests {
             p_value: chi2_survival(reduced * 398.0, 398.0),
             at_noise_level: chi2_survival(reduced * 398.0, 398.0) > NOISE_LEVEL,
             structure_p: 0.5,
+            model_form_accounted: true,
             evaluations: 0,
             failures: Vec::new(),
             at_bound: Vec::new(),
@@ -381,5 +383,8 @@ mod tests {
         // Above the noise level a small share with strong evidence is still named.
         let above = vec![candidate("a", Some((0.96 * 1.5 * 398.0, 0.04, -20.0)), None)];
         assert_eq!(decide(&base(1.5), 400, &above, &[]).cause.as_deref(), Some("a"));
+        // So is it without a model-form floor, which leaves nothing to soak up.
+        let no_floor = BaseFit { model_form_accounted: false, ..base(0.98) };
+        assert_eq!(decide(&no_floor, 400, &small, &[]).cause.as_deref(), Some("a"));
     }
 }
