@@ -35,7 +35,7 @@ pub struct Spring {
 }
 
 /// Everything the solver needs to know about a discretised test.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct FeProblem {
     /// Nodes, layers, unknowns.
     pub mesh: Mesh,

@@ -64,7 +64,7 @@ pub struct Layer {
 }
 
 /// Nodes, layers and the numbering of unknowns.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     /// Axial node coordinates (mm), strictly increasing.
     pub x: Vec<f64>,

@@ -11,6 +11,7 @@
 //! * [`newton`]: Newton–Raphson under displacement or dissipation control;
 //! * [`path`]: path following (adaptive steps, output grid, snap-back detours);
 //! * [`run_types`]: what a run is asked and returns (settings, rows, statistics), shared by `path` and `window`;
+//! * `pool`: work arrays reused across the runs of a thread;
 //! * `window`: the solution restricted to the nodes around a crack front, the linear regions
 //!   behind and ahead condensed exactly (used by [`path::run_with`]);
 //! * [`energy`]: external work, elastic and dissipated energy;
@@ -38,6 +39,7 @@ pub mod mesh;
 pub mod newton;
 pub mod nonlinear;
 pub mod path;
+pub(crate) mod pool;
 pub mod run_types;
 pub mod segment;
 pub(crate) mod window;

@@ -30,6 +30,10 @@
 //! **Energies** of `L` and `R` follow from Clapeyron's theorem: a linear substructure loaded only
 //! at its boundary stores half the work of the boundary forces on the boundary displacements.
 
+use std::any::Any;
+use std::cell::RefCell;
+use std::rc::Rc;
+
 use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent, Traction};
 
 use super::assembly::FeProblem;
@@ -38,6 +42,7 @@ use super::crack::CrackMeasures;
 use super::energy::path_work;
 use super::interface::{self, PointKind};
 use super::mesh::NONE;
+use super::pool::{self, Pooled};
 use super::run_types::{FrontTrack, PathSettings, RunStats, StepRow};
 use super::segment::{self, End, ModeOne, Segment};
 
@@ -471,6 +476,10 @@ fn linear_domain(law: &dyn CohesiveLaw, m: &ModeOne) -> Option<Linear> {
     let mut lo = 0.0;
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
+        // Converged to round-off: further halvings would not move either end.
+        if mid <= lo || mid >= hi {
+            break;
+        }
         if dmg(Gap::new(0.0, mid)) > 0.0 {
             hi = mid;
         } else {
@@ -526,65 +535,106 @@ struct PointRecord {
 
 /// Solves `p` along `s` with the window; the rows at the output abscissae.
 pub(crate) fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Vec<StepRow>, RunStats), Unfit> {
-    let (nodes, owner, fixed) = node_dofs(p)?;
+    let (d, layout) = prepared(p)?;
     let mode_one = ModeOne::of(law).ok_or(Unfit::Structure("the law has no elastic domain in mode I"))?;
     let lin = linear_domain(law, &mode_one).ok_or(Unfit::Structure("the law is not linear near the origin"))?;
-    let d = nodes.iter().map(|n| n.d).max().unwrap_or(0);
     macro_rules! with {
         ($d:literal) => {{
-            let lay = Layout::<$d>::new(p, &nodes, &owner, &fixed)?;
+            let lay = layout.downcast::<Layout<$d>>().map_err(|_| Unfit::Structure("layout of another node size"))?;
             Solver::new(p, law, s, lay, lin, mode_one)?.run()
         }};
     }
     match d {
-        0..=2 => with!(2),
+        2 => with!(2),
         3 => with!(3),
         4 => with!(4),
-        5 | 6 => with!(6),
+        6 => with!(6),
         _ => with!(8),
     }
 }
+
+/// How many problems' layouts a thread keeps.
+const LAYOUTS_KEPT: usize = 4;
+
+thread_local! {
+    /// Layouts of the last problems run on this thread, most recent last. A layout does not depend
+    /// on the law, so the runs of an identification (one problem per experiment, thousands of
+    /// laws) build it once.
+    static LAYOUTS: RefCell<Vec<(FeProblem, usize, Rc<dyn Any>)>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The node block size and layout of `p`, from this thread's cache or built.
+fn prepared(p: &FeProblem) -> Result<(usize, Rc<dyn Any>), Unfit> {
+    let hit = LAYOUTS.with(|c| c.borrow().iter().rev().find(|e| e.0 == *p).map(|e| (e.1, e.2.clone())));
+    if let Some(hit) = hit {
+        return Ok(hit);
+    }
+    let (nodes, owner, fixed) = node_dofs(p)?;
+    let d = match nodes.iter().map(|n| n.d).max().unwrap_or(0) {
+        0..=2 => 2,
+        3 => 3,
+        4 => 4,
+        5 | 6 => 6,
+        _ => 8,
+    };
+    let layout: Rc<dyn Any> = match d {
+        2 => Rc::new(Layout::<2>::new(p, &nodes, &owner, &fixed)?),
+        3 => Rc::new(Layout::<3>::new(p, &nodes, &owner, &fixed)?),
+        4 => Rc::new(Layout::<4>::new(p, &nodes, &owner, &fixed)?),
+        6 => Rc::new(Layout::<6>::new(p, &nodes, &owner, &fixed)?),
+        _ => Rc::new(Layout::<8>::new(p, &nodes, &owner, &fixed)?),
+    };
+    LAYOUTS.with(|c| {
+        let mut c = c.borrow_mut();
+        if c.len() == LAYOUTS_KEPT {
+            c.remove(0);
+        }
+        c.push((p.clone(), d, layout.clone()));
+    });
+    Ok((d, layout))
+}
+
 struct Solver<'a, const D: usize> {
     p: &'a FeProblem,
     law: &'a dyn CohesiveLaw,
     s: &'a PathSettings,
-    lay: Layout<D>,
+    lay: Rc<Layout<D>>,
     lin: Linear,
     mode_one: ModeOne,
     /// Elastic segment blocks (segment k between nodes first + k and first + k + 1).
-    es_aa: Vec<Blk<D>>,
-    es_ab: Vec<Blk<D>>,
+    es_aa: Pooled<Blk<D>>,
+    es_ab: Pooled<Blk<D>>,
     /// Right region: `q_{j} = tr[j] q_{j−1}` for j > i1.
-    tr: Vec<Blk<D>>,
+    tr: Pooled<Blk<D>>,
     /// Left region: `q_j = tl[j] q_{j+1} + tlc[j] c` for j < i0, and the eliminated state.
-    tl: Vec<Blk<D>>,
-    tlc: Vec<Vct<D>>,
+    tl: Pooled<Blk<D>>,
+    tlc: Pooled<Vct<D>>,
     rho: Vct<D>,
     sigma: f64,
     /// Window.
     i0: usize,
     i1: usize,
     /// Unknowns per node (valid inside the window) and their values one step back.
-    q: Vec<Vct<D>>,
-    q_prev: Vec<Vct<D>>,
+    q: Pooled<Vct<D>>,
+    q_prev: Pooled<Vct<D>>,
     c: f64,
-    pts: Vec<PointRecord>,
+    pts: Pooled<PointRecord>,
     /// Dissipation of the points that left the window (failed; N·mm).
     frozen: f64,
     /// Decay length of the beam on its elastic interface (mm), for the check zones.
     decay: f64,
     // Newton workspace.
-    ev: Vec<LawEval>,
-    dt: Vec<Tangent>,
-    gaps: Vec<Gap>,
-    fronts: Vec<[Option<f64>; 2]>,
-    seg_stored: Vec<f64>,
-    jd: Vec<Blk<D>>,
-    ju: Vec<Blk<D>>,
-    jl: Vec<Blk<D>>,
-    res: Vec<Vct<D>>,
-    lus: Vec<Lu<D>>,
-    rhs: Vec<Vct<D>>,
+    ev: Pooled<LawEval>,
+    dt: Pooled<Tangent>,
+    gaps: Pooled<Gap>,
+    fronts: Pooled<[Option<f64>; 2]>,
+    seg_stored: Pooled<f64>,
+    jd: Pooled<Blk<D>>,
+    ju: Pooled<Blk<D>>,
+    jl: Pooled<Blk<D>>,
+    res: Pooled<Vct<D>>,
+    lus: Pooled<Lu<D>>,
+    rhs: Pooled<Vct<D>>,
     reaction: f64,
     committed_reaction: f64,
     stats: RunStats,
@@ -595,14 +645,18 @@ impl<'a, const D: usize> Solver<'a, D> {
         p: &'a FeProblem,
         law: &'a dyn CohesiveLaw,
         s: &'a PathSettings,
-        lay: Layout<D>,
+        lay: Rc<Layout<D>>,
         lin: Linear,
         mode_one: ModeOne,
     ) -> Result<Self, Unfit> {
         let nn = lay.kd.len();
         let ns = lay.segs.len();
-        let (mut es_aa, mut es_ab, mut es_ba, mut es_bb) =
-            (vec![zb::<D>(); ns], vec![zb::<D>(); ns], vec![zb::<D>(); ns], vec![zb::<D>(); ns]);
+        let (mut es_aa, mut es_ab, mut es_ba, mut es_bb) = (
+            pool::take(ns, zb::<D>()),
+            pool::take(ns, zb::<D>()),
+            pool::take(ns, zb::<D>()),
+            pool::take(ns, zb::<D>()),
+        );
         for (k, sg) in lay.segs.iter().enumerate() {
             let (ga, gb) = (&lay.chain[k].grad, &lay.chain[k + 1].grad);
             let kk = lin.k0;
@@ -627,7 +681,7 @@ impl<'a, const D: usize> Solver<'a, D> {
             put(&mut es_bb[k], gb, gb, 1.0 / 3.0);
         }
         // Right region, eliminated from the far end: q_j = tr[j] q_{j−1}.
-        let mut tr = vec![zb::<D>(); nn];
+        let mut tr = pool::take(nn, zb::<D>());
         let mut next: Option<Blk<D>> = None; // E_{j,j+1} tr[j+1]
         for j in (lay.first + 1..=lay.last).rev() {
             let mut dd = lay.kd[j];
@@ -668,7 +722,7 @@ impl<'a, const D: usize> Solver<'a, D> {
         };
         let np = p.points.len();
         let init = law.initial_state();
-        let pts = vec![PointRecord { state: init, work: 0.0, t: Traction::zeros(), g: Gap::zeros() }; np];
+        let pts = pool::take(np, PointRecord { state: init, work: 0.0, t: Traction::zeros(), g: Gap::zeros() });
         let first = lay.first;
         let mut w = Solver {
             p,
@@ -679,29 +733,29 @@ impl<'a, const D: usize> Solver<'a, D> {
             es_aa,
             es_ab,
             tr,
-            tl: vec![zb::<D>(); nn],
-            tlc: vec![[0.0; D]; nn],
+            tl: pool::take(nn, zb::<D>()),
+            tlc: pool::take(nn, [0.0; D]),
             rho: [0.0; D],
             sigma: lay.kcc,
             i0: 0,
             i1: first,
-            q: vec![[0.0; D]; nn],
-            q_prev: vec![[0.0; D]; nn],
+            q: pool::take(nn, [0.0; D]),
+            q_prev: pool::take(nn, [0.0; D]),
             c: 0.0,
             pts,
             frozen: 0.0,
             decay,
-            ev: vec![LawEval { traction: Traction::zeros(), tangent: Tangent::zeros(), state: init }; np],
-            dt: vec![Tangent::zeros(); np],
-            gaps: vec![Gap::zeros(); np],
-            fronts: vec![[None; 2]; ns],
-            seg_stored: vec![0.0; ns],
-            jd: vec![zb::<D>(); nn],
-            ju: vec![zb::<D>(); nn],
-            jl: vec![zb::<D>(); nn],
-            res: vec![[0.0; D]; nn],
-            lus: Vec::new(),
-            rhs: Vec::new(),
+            ev: pool::take(np, LawEval { traction: Traction::zeros(), tangent: Tangent::zeros(), state: init }),
+            dt: pool::take(np, Tangent::zeros()),
+            gaps: pool::take(np, Gap::zeros()),
+            fronts: pool::take(ns, [None; 2]),
+            seg_stored: pool::take(ns, 0.0),
+            jd: pool::take(nn, zb::<D>()),
+            ju: pool::take(nn, zb::<D>()),
+            jl: pool::take(nn, zb::<D>()),
+            res: pool::take(nn, [0.0; D]),
+            lus: pool::take(0, Lu { m: zb::<D>(), perm: [0; D] }),
+            rhs: pool::take(0, [0.0; D]),
             reaction: 0.0,
             committed_reaction: 0.0,
             stats: RunStats::default(),
@@ -1272,8 +1326,11 @@ impl<'a, const D: usize> Solver<'a, D> {
         let mut k_out = 1usize;
         let mut external = 0.0f64;
         let mut front = FrontTrack::default();
-        let mut states: Vec<LawState> = self.pts.iter().map(|r| r.state).collect();
-        let mut saved_q = vec![[0.0; D]; self.q.len()];
+        let mut states = pool::take(self.pts.len(), LawState::default());
+        for (st, r) in states.iter_mut().zip(self.pts.iter()) {
+            *st = r.state;
+        }
+        let mut saved_q = pool::take(self.q.len(), [0.0; D]);
         // Last node with sizeable gaps at the last commit.
         let mut need_node = self.i1;
         let max_steps = 200 * s.outputs + 20_000;
