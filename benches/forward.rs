@@ -1,5 +1,11 @@
 //! Forward-model benchmarks: full DCB runs as an identification performs them thousands of times.
 //!
+//! * `dcb_paper_population`: Shi & Zhang's DCB at the mesh of `examples/paper-dcb/problem.toml`
+//!   (0.1 mm interface elements, to 10 mm), one iteration per law of a population of 50 ST-CZM
+//!   laws drawn in that problem's parameter ranges (`benches/common/population.rs`): an
+//!   identification's runs, which no cache across runs of one law can serve.
+//! * `dcb_hartlen_population`: Hartlen's DCB-01 to 30 mm over 50 bilinear laws (20–60 MPa,
+//!   G_Ic 0.5–1.2 N/mm).
 //! * `dcb_paper_table3`: Shi & Zhang's DCB, 0.1 mm interface elements, ST-CZM Table 3, to the
 //!   default final opening (crack 60 % of the way to the end by beam theory).
 //! * `dcb_hartlen_30mm`: Hartlen's DCB-01 to 30 mm opening, bilinear law (G_Ic = 0.8 N/mm).
@@ -21,6 +27,9 @@
 //! forward models chapter of the book lists the measured medians, and `examples/dcb_profile.rs`
 //! runs the same cases for profilers.
 
+#[path = "common/population.rs"]
+mod population;
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use czid_core::ForwardModel;
 use czid_models::dcb::Dcb;
@@ -32,6 +41,28 @@ use czid_models::mmb::Mmb;
 fn forward(c: &mut Criterion) {
     let mut g = c.benchmark_group("forward");
     g.sample_size(20);
+    // Each iteration runs the next law of the population, so the median is over all of them.
+    let mut paper_example = Dcb::paper();
+    paper_example.mesh.interface_element = 0.1;
+    paper_example.mesh.arm_element = 0.5;
+    paper_example.control.max_displacement = Some(10.0);
+    let laws = population::paper_laws(50, 1);
+    let mut k = 0;
+    g.bench_function("dcb_paper_population", |b| {
+        b.iter(|| {
+            k = (k + 1) % laws.len();
+            paper_example.simulate(laws[k].as_ref()).unwrap()
+        })
+    });
+    let hartlen_laws = population::hartlen_laws(50, 1);
+    let hartlen_dcb = Dcb::hartlen_dcb01();
+    let mut k = 0;
+    g.bench_function("dcb_hartlen_population", |b| {
+        b.iter(|| {
+            k = (k + 1) % hartlen_laws.len();
+            hartlen_dcb.simulate(hartlen_laws[k].as_ref()).unwrap()
+        })
+    });
     let paper = Dcb::paper();
     let t3 = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap();
     g.bench_function("dcb_paper_table3", |b| b.iter(|| paper.simulate(&t3).unwrap()));
