@@ -556,16 +556,23 @@ pub(crate) fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Res
 /// How many problems' layouts a thread keeps.
 const LAYOUTS_KEPT: usize = 4;
 
+/// A problem, its node block size and its layout (a `Layout<D>` of that size).
+struct Prepared {
+    problem: FeProblem,
+    d: usize,
+    layout: Rc<dyn Any>,
+}
+
 thread_local! {
     /// Layouts of the last problems run on this thread, most recent last. A layout does not depend
     /// on the law, so the runs of an identification (one problem per experiment, thousands of
     /// laws) build it once.
-    static LAYOUTS: RefCell<Vec<(FeProblem, usize, Rc<dyn Any>)>> = const { RefCell::new(Vec::new()) };
+    static LAYOUTS: RefCell<Vec<Prepared>> = const { RefCell::new(Vec::new()) };
 }
 
 /// The node block size and layout of `p`, from this thread's cache or built.
 fn prepared(p: &FeProblem) -> Result<(usize, Rc<dyn Any>), Unfit> {
-    let hit = LAYOUTS.with(|c| c.borrow().iter().rev().find(|e| e.0 == *p).map(|e| (e.1, e.2.clone())));
+    let hit = LAYOUTS.with(|c| c.borrow().iter().rev().find(|e| e.problem == *p).map(|e| (e.d, e.layout.clone())));
     if let Some(hit) = hit {
         return Ok(hit);
     }
@@ -589,7 +596,7 @@ fn prepared(p: &FeProblem) -> Result<(usize, Rc<dyn Any>), Unfit> {
         if c.len() == LAYOUTS_KEPT {
             c.remove(0);
         }
-        c.push((p.clone(), d, layout.clone()));
+        c.push(Prepared { problem: p.clone(), d, layout: layout.clone() });
     });
     Ok((d, layout))
 }
