@@ -209,6 +209,33 @@ fn windowed_solution_equals_the_whole_mesh_solution() {
 }
 
 #[test]
+fn a_thread_that_ran_other_problems_gives_the_records_of_a_fresh_one() {
+    // Windowed runs keep their problem's layout and their work arrays per thread for the next run:
+    // what another specimen, another law or a failed run left behind must not show in a record.
+    use czid_core::ForwardModel;
+    let table3 = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap();
+    let bilinear = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
+    let mut short = Dcb::paper();
+    short.control.max_displacement = Some(4.0);
+    let mut thinner = short.clone();
+    thinner.h = 1.5;
+    let fresh = |d: Dcb, law: StCzm| std::thread::spawn(move || d.simulate(&law).unwrap()).join().unwrap();
+    let expected = fresh(thinner.clone(), table3.clone());
+    // This thread first runs other problems and laws (one of them on a longer specimen, so its
+    // arrays are larger than the next run needs).
+    short.simulate(&table3).unwrap();
+    Dcb::hartlen_dcb01().simulate(&bilinear).unwrap();
+    let other_law = StCzm::sawtooth(45.0, 0.0004, 0.005, 60.0, 0.0004, 0.005).unwrap();
+    thinner.simulate(&other_law).unwrap();
+    let reused = thinner.simulate(&table3).unwrap();
+    assert_eq!(reused, expected, "a reused thread gives the fresh thread's record, bit for bit");
+    // The same specimen changed after a run is not served the old specimen's layout.
+    let changed = fresh(short.clone(), table3.clone());
+    assert_ne!(changed, expected, "the two specimens differ");
+    assert_eq!(short.simulate(&table3).unwrap(), changed);
+}
+
+#[test]
 fn debonded_length_follows_the_damage_threshold() {
     // A lower threshold counts part of the process zone as debonded: the debonded length grows by
     // the distance between the fronts at damage 0.5 and at complete failure, the process zone
