@@ -533,6 +533,12 @@ impl<'a> WholeMesh<'a> {
 /// superposes two fronts). Unknowns of nodes within `zone` of the front at `x` are replaced by the
 /// current solution translated by the predicted advance `da` (interpolated linearly between
 /// nodes); Newton then only corrects the shape.
+///
+/// Under large rotations the axial displacements are left to the extrapolation: there an arm's
+/// axial displacement carries the shortening of its rotated length, which accumulates along the
+/// arm instead of travelling with the front, and translating it put jumps at the zone's edges that
+/// the axial stiffness turned into residuals as large as the internal forces (two wasted Newton
+/// iterations per step, and steps cut to an eighth of the output spacing).
 fn shift_predictor(p: &FeProblem, cur: &[f64], trial: &mut [f64], x: f64, da: f64, zone: f64) {
     use super::mesh::NONE;
     let xs = &p.mesh.x;
@@ -546,7 +552,9 @@ fn shift_predictor(p: &FeProblem, cur: &[f64], trial: &mut [f64], x: f64, da: f6
         let t = ((xt - xs[j]) / (xs[j + 1] - xs[j])).clamp(0.0, 1.0);
         for layer in 0..p.mesh.layers.len() {
             let (di, dj, dk) = (p.mesh.dofs(layer, i), p.mesh.dofs(layer, j), p.mesh.dofs(layer, j + 1));
-            for c in 0..4 {
+            // [u, w, θ, s]: the axial displacement only under small rotations (see above).
+            let first = usize::from(p.large_rotation);
+            for c in first..4 {
                 if di[c] != NONE && dj[c] != NONE && dk[c] != NONE && di[c] != p.control {
                     trial[di[c]] = (1.0 - t) * cur[dj[c]] + t * cur[dk[c]];
                 }
