@@ -190,8 +190,8 @@ pub fn interface_stored(points: &[InterfacePoint], law: &dyn CohesiveLaw, trial:
     for (ip, p) in points.iter().enumerate() {
         let psi = match p.kind {
             PointKind::Cohesive => law.stored_energy(&gaps[ip], &trial[ip].state),
-            // Contact is a linear penalty: ½ T·g.
-            PointKind::Contact => 0.5 * trial[ip].traction.dot(&gaps[ip]),
+            // The normal penalty and, with friction, the stick spring (½ T·g without friction).
+            PointKind::Contact => super::interface::contact_stored(&trial[ip], &gaps[ip]),
         };
         e += p.area * p.factor * psi;
     }
