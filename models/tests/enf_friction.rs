@@ -103,6 +103,31 @@ fn the_load_at_a_deflection_and_the_peak_grow_with_friction() {
     }
 }
 
+#[test]
+fn an_unstable_enf_with_friction_still_follows_the_crack() {
+    // The case of `enf_beam.rs` whose dissipation-controlled detour once followed an elastic
+    // unloading of the contact: with friction that unloading would dissipate (the faces slip
+    // back), so the guard against it, a step that dissipates nothing, must not be fooled.
+    let mut e = Enf::hartlen_enf03();
+    e.a0 = 33.5;
+    e.material.e11 = 32_554.79;
+    e.mesh.interface_element = 0.25;
+    e.control.max_displacement = Some(5.58);
+    e.effects.crack_face_friction = 0.3;
+    let law = Bilinear::bk(1e5, 9.654621, 31.94808, 0.8162914, 3.485673, 2.0).unwrap();
+    let rec = e.simulate(&law).unwrap_or_else(|f| panic!("{}", f.error));
+    let (x, p) = (col(&rec, columns::DISPLACEMENT), col(&rec, columns::LOAD));
+    let diss = col(&rec, columns::DISSIPATED_ENERGY);
+    assert!((x.last().unwrap() - 5.58).abs() < 1e-9, "ends at {}", x.last().unwrap());
+    assert!(diss.windows(2).all(|w| w[1] >= w[0] - 1e-9 * w[0].abs().max(1.0)), "dissipation decreased");
+    let peak = x.iter().zip(p).fold((0.0, 0.0f64), |m, (x, p)| if *p > m.1 { (*x, *p) } else { m });
+    let after: Vec<f64> = x.iter().copied().skip_while(|v| *v < peak.0).collect();
+    assert!(after.iter().all(|v| *v > 0.5 * peak.0), "a row fell back towards zero opening");
+    let tip = col(&rec, columns::CRACK_TIP);
+    println!("peak {:.1} N at {:.3} mm; crack tip at the end {:.2} mm", peak.1, peak.0, tip.last().unwrap());
+    assert!(*tip.last().unwrap() > e.a0 + 5.0, "the crack ran (tip at {})", tip.last().unwrap());
+}
+
 /// The friction measures of the loading branch, stepped by Newton's method on the model's own
 /// problem: a law too strong to damage at these loads, so the only dissipation is friction's.
 struct Branch {
