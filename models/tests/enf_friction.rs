@@ -105,9 +105,10 @@ fn the_load_at_a_deflection_and_the_peak_grow_with_friction() {
 
 #[test]
 fn an_unstable_enf_with_friction_still_follows_the_crack() {
-    // The case of `enf_beam.rs` whose dissipation-controlled detour once followed an elastic
-    // unloading of the contact: with friction that unloading would dissipate (the faces slip
-    // back), so the guard against it, a step that dissipates nothing, must not be fooled.
+    // The case of `enf_beam.rs` where the dissipation constraint can be met on an elastic
+    // unloading of the contact instead of the crack's growth: with friction that unloading
+    // dissipates too (the faces slip back), so the path's guard against it (a step that
+    // dissipates nothing is refused) must still lead along the crack.
     let mut e = Enf::hartlen_enf03();
     e.a0 = 33.5;
     e.material.e11 = 32_554.79;
