@@ -315,7 +315,7 @@ pub fn to_record(rows: &[StepRow], s: &RowScale) -> Record {
 }
 
 /// The interface of two arms (layer 0 below, layer 1 above) on nodes `0..=last`, cracked up to
-/// node `tip`: frictionless contact points on the cracked faces, cohesive points from the crack
+/// node `tip`: contact points (frictionless unless the problem sets `contact_friction`) on the cracked faces, cohesive points from the crack
 /// front on (the front node carries both, each with its side's tributary length), and with a
 /// root compliance `root_compliance > 0` (mm/MPa) a through-thickness spring of each arm's surface
 /// at every bonded node (the layers must carry surface unknowns there).

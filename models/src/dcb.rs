@@ -144,6 +144,7 @@ impl Dcb {
         beamtest::check_memory(OWNER, &self.mesh, (self.length - self.a0).max(0.0) / self.mesh.crack_element())?;
         self.control.validate(OWNER)?;
         self.effects.validate(OWNER)?;
+        self.effects.reject_friction(OWNER, "DCB")?;
         let a = self.effective_crack_length();
         if !(a > 0.0 && a < self.length) {
             return Err(CzError::invalid(
@@ -292,7 +293,16 @@ impl Dcb {
         let arm_to_opening = if half { 2.0 } else { 1.0 };
         let load_point = LoadPoint { dof: w_up, per_unit: arm_to_opening, share: factor, at_first_node: true };
         let (control, scale) = recorded_control(fx.machine_compliance, fx.readout(), load_point, &mut springs);
-        let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: large, contact_stiffness: 0.0 };
+        let p = FeProblem {
+            mesh,
+            points,
+            springs,
+            fixed,
+            control,
+            large_rotation: large,
+            contact_stiffness: 0.0,
+            contact_friction: 0.0,
+        };
         Ok((p, scale))
     }
 

@@ -38,7 +38,26 @@ pub struct Effects {
     pub load_offset: f64,
     /// Depth of a smooth seating toe (mm), see [`crate::measurement::Readout`]. 0: none.
     pub seating_toe: f64,
+    /// Coulomb friction coefficient μ between the cracked faces (dimensionless): where the arms
+    /// press on each other behind the crack front (ENF, MMB), a slip is resisted by up to μ times
+    /// the contact pressure ([`crate::fe::interface::frictional_contact`]); the friction work is
+    /// dissipated energy. 0: frictionless contact. Only models with contact on the cracked faces
+    /// accept a non-zero value.
+    pub crack_face_friction: f64,
 }
+
+/// Coulomb friction between the cracked faces of a mode II or mixed-mode test.
+pub const CRACK_FACE_FRICTION: EffectDeclaration = EffectDeclaration {
+    name: "crack_face_friction",
+    description: "Coulomb friction between the cracked faces where the arms press on each other",
+    field: "effects.crack_face_friction",
+    unit: "1 (coefficient μ)",
+    kind: EffectKind::Size { range: [0.0, 0.5], null: 0.0 },
+    scope: EffectScope::Shared,
+    // Dry friction of cured epoxy composite faces, as assumed for ENF (Carlsson, Gillespie &
+    // Pipes 1986 take 0.25–0.5).
+    typical: Some(Typical { magnitude: [0.2, 0.5], sign: Sign::Positive }),
+};
 
 /// Large rotations of the arms (a switch).
 pub const LARGE_ROTATION: EffectDeclaration = EffectDeclaration {
@@ -101,6 +120,31 @@ impl Effects {
         out
     }
 
+    /// The effects of a test whose cracked faces press on each other (ENF, MMB): those of
+    /// [`Effects::declarations`] and [`CRACK_FACE_FRICTION`].
+    pub fn declarations_with_contact() -> Vec<EffectDeclaration> {
+        let mut out = Self::declarations(false);
+        out.push(CRACK_FACE_FRICTION);
+        out
+    }
+
+    /// Refuses a non-zero `crack_face_friction` in a model of type `model` whose cracked faces
+    /// never touch (no contact, so nothing for friction to act on).
+    pub fn reject_friction(&self, owner: &str, model: &str) -> Result<()> {
+        if self.crack_face_friction != 0.0 {
+            return Err(CzError::invalid(
+                owner,
+                "effects.crack_face_friction",
+                self.crack_face_friction,
+                format!(
+                    "the {model} model has no contact between the cracked faces, so no friction; \
+                     remove the field or set it to 0"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// How the instruments read the specimen (the measurement effects but the machine's).
     pub fn readout(&self) -> crate::measurement::Readout {
         crate::measurement::Readout {
@@ -116,6 +160,7 @@ impl Effects {
         require_non_negative(owner, "effects.root_compliance", self.root_compliance)?;
         require_non_negative(owner, "effects.shear_compliance", self.shear_compliance)?;
         require_non_negative(owner, "effects.seating_toe", self.seating_toe)?;
+        require_non_negative(owner, "effects.crack_face_friction", self.crack_face_friction)?;
         if !self.load_offset.is_finite() {
             return Err(CzError::invalid(owner, "effects.load_offset", self.load_offset, "must be finite"));
         }

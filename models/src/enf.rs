@@ -3,8 +3,10 @@
 //! Three-point bending of a beam made of two equal layers: supports under the lower layer at
 //! `x = 0` and `x = 2L`, the load on the upper layer at mid-span `x = L`. A mid-plane crack runs
 //! from the left support to `x = a0`; beyond it the layers are joined by the cohesive law. On the
-//! cracked faces a frictionless normal contact penalty keeps the arms from interpenetrating (the
-//! arms press on each other there); its stiffness defaults to the law's normal penalty. The
+//! cracked faces a normal contact penalty keeps the arms from interpenetrating (the arms press on
+//! each other there); its stiffness defaults to the law's normal penalty. The contact is
+//! frictionless unless `effects.crack_face_friction` sets a Coulomb coefficient
+//! ([`crate::fe::interface::frictional_contact`]). The
 //! applied displacement is the load-point deflection (positive downwards) and the load the
 //! force at the loading nose.
 //!
@@ -151,7 +153,17 @@ impl Enf {
         let (control, scale) =
             crate::measurement::recorded_control(fx.machine_compliance, fx.readout(), load_point, &mut springs);
         let contact_stiffness = self.contact_stiffness.unwrap_or(law.initial_stiffness()[0]);
-        let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: false, contact_stiffness };
+        let contact_friction = fx.crack_face_friction;
+        let p = FeProblem {
+            mesh,
+            points,
+            springs,
+            fixed,
+            control,
+            large_rotation: false,
+            contact_stiffness,
+            contact_friction,
+        };
         Ok((p, scale))
     }
 
@@ -176,8 +188,9 @@ impl ForwardModel for Enf {
     }
 
     fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
-        // The ENF model has no large-rotation option (it refuses `effects.large_rotation`).
-        crate::effects::Effects::declarations(false)
+        // The ENF model has no large-rotation option (it refuses `effects.large_rotation`); its
+        // cracked faces touch, so friction on them is a candidate.
+        crate::effects::Effects::declarations_with_contact()
     }
 
     /// The continuum ENF of the same specimen ([`crate::enf_2d::Enf2d::from_beam`]).

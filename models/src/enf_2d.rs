@@ -91,8 +91,11 @@ impl Enf2d {
     /// The continuum ENF of the specimen a beam ENF describes, with the beam's effects carried
     /// over as [`crate::dcb_2d::Dcb2d::from_beam`] does (the extra compliances as the material
     /// change they stand for). The mesh keeps the beam's interface element.
+    /// The continuum's contact is frictionless: a beam with `effects.crack_face_friction` has no
+    /// continuum counterpart (an error).
     pub fn from_beam(beam: &crate::enf::Enf) -> Result<Enf2d> {
         let fx = &beam.effects;
+        fx.reject_friction("model enf_2d (built from an enf)", "continuum ENF")?;
         let material = crate::dcb_2d::material_of_beam(&beam.material, fx, beam.h);
         let m = Enf2d {
             a0: beam.a0,

@@ -7,8 +7,9 @@
 //! hinge by `P c/L` and pushed down at the saddle by `P (c + L)/L`: the superposition of a DCB
 //! opening load `P_I = P (3c − L)/(4L)` and an ENF load `P_II = P (c + L)/L` (Reeder & Crews), so
 //! the lever length sets the mode ratio, from pure mode II at `c = L/3` towards mode I as `c`
-//! grows. A mid-plane crack runs from `x = 0` to `a0`; the cracked faces carry frictionless contact
-//! (as in [`crate::enf`]), the rest the cohesive law. The applied displacement is the lever's
+//! grows. A mid-plane crack runs from `x = 0` to `a0`; the cracked faces carry contact, frictionless
+//! unless `effects.crack_face_friction` is set (as in [`crate::enf`]; here the ends do not press on
+//! each other for any lever length, see `effects()`), the rest the cohesive law. The applied displacement is the lever's
 //! load-point displacement (positive downwards) and the load the force `P` on the lever.
 //!
 //! **The lever in the mesh.** The lever couples the hinge and the saddle, nodes far apart, which
@@ -305,7 +306,17 @@ impl Mmb {
         let lever_compliance = self.tie_compliance(mid);
         scale.compliance -= lever_compliance;
         let contact_stiffness = self.contact_stiffness.unwrap_or(law.initial_stiffness()[0]);
-        let p = FeProblem { mesh, points, springs, fixed, control, large_rotation: false, contact_stiffness };
+        let contact_friction = fx.crack_face_friction;
+        let p = FeProblem {
+            mesh,
+            points,
+            springs,
+            fixed,
+            control,
+            large_rotation: false,
+            contact_stiffness,
+            contact_friction,
+        };
         Ok((p, scale, lever_compliance))
     }
 
@@ -365,7 +376,10 @@ impl ForwardModel for Mmb {
     }
 
     fn effects(&self) -> Vec<czid_core::EffectDeclaration> {
-        // No large-rotation option (the model refuses `effects.large_rotation`).
+        // No large-rotation option (the model refuses `effects.large_rotation`). Friction on the
+        // cracked faces is honoured but not declared: the lever's hinge pulls the cracked ends
+        // apart by at least what the ENF part of the load presses them with (beam theory: they
+        // press with P (L − 3c)/(4L) ≤ 0 for c ≥ L/3), so it has nothing to act on.
         crate::effects::Effects::declarations(false)
     }
 

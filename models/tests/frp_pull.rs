@@ -459,8 +459,16 @@ fn elastic_concrete_equals_a_two_layer_model_with_a_concrete_layer() {
         fixed.extend([mesh.dofs(0, i)[1], mesh.dofs(0, i)[2], mesh.dofs(1, i)[1], mesh.dofs(1, i)[2]]);
     }
     let control = mesh.dofs(1, 0)[0];
-    let problem =
-        FeProblem { mesh, points, springs: vec![], fixed, control, large_rotation: false, contact_stiffness: 0.0 };
+    let problem = FeProblem {
+        mesh,
+        points,
+        springs: vec![],
+        fixed,
+        control,
+        large_rotation: false,
+        contact_stiffness: 0.0,
+        contact_friction: 0.0,
+    };
     let target = 0.7; // on the plateau: the loaded end separates at 0.485 mm
     let path = PathSettings {
         target: -target,

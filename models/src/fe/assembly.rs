@@ -50,8 +50,12 @@ pub struct FeProblem {
     pub control: usize,
     /// Co-rotational (large-rotation) kinematics for beams and interfaces.
     pub large_rotation: bool,
-    /// Normal penalty of contact-only points (MPa/mm).
+    /// Normal penalty of contact-only points (MPa/mm), also the stiffness of their stick spring
+    /// when they carry friction.
     pub contact_stiffness: f64,
+    /// Coulomb friction coefficient of contact-only points (dimensionless); 0: frictionless
+    /// ([`interface::contact`]), else [`interface::frictional_contact`].
+    pub contact_friction: f64,
 }
 
 struct Element {
@@ -231,7 +235,11 @@ impl Assembler {
                     (ev, d)
                 }
                 PointKind::Contact => {
-                    let ev = interface::contact(&gap, p.contact_stiffness);
+                    let ev = if p.contact_friction == 0.0 {
+                        interface::contact(&gap, p.contact_stiffness)
+                    } else {
+                        interface::frictional_contact(&gap, &states[ip], p.contact_stiffness, p.contact_friction)
+                    };
                     (ev, ev.tangent)
                 }
             };
@@ -367,12 +375,19 @@ impl Assembler {
 
     /// Recoverable energy of the interface integrated as the forces are: the segments' `∫ ½ T·g`
     /// and the nodal rule for the points outside segments (N·mm). `stored` holds each point's
-    /// own recoverable energy per unit area.
+    /// own recoverable energy per unit area; with friction, a contact point's is taken from its
+    /// last evaluation instead ([`interface::contact_stored`]: its stick spring stores
+    /// `T_t²/(2k)`, not `½ T_t g_t`).
     pub fn interface_stored(&self, p: &FeProblem, stored: &[f64]) -> f64 {
         let mut e: f64 = self.segment_stored.iter().sum();
         for (i, pt) in p.points.iter().enumerate() {
             if !self.covered[i] {
-                e += pt.area * pt.factor * stored[i];
+                let psi = if pt.kind == PointKind::Contact && p.contact_friction != 0.0 {
+                    interface::contact_stored(&self.trial[i], &self.gaps[i])
+                } else {
+                    stored[i]
+                };
+                e += pt.area * pt.factor * psi;
             }
         }
         e

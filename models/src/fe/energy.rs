@@ -8,7 +8,10 @@
 //!   minus their recoverable energy. It is computed point by point, independently of the external
 //!   work, so that `W = elastic + dissipated` is a genuine check of equilibrium and of the step size
 //!   (the trapezoidal rule is exact on linear pieces of a law, so its error comes only from steps
-//!   that straddle a kink of a law).
+//!   that straddle a kink of a law). Contact points with friction are interface points like the
+//!   others: the work done on them includes the friction's, and they store only their normal
+//!   penalty's and stick spring's energy ([`super::interface::contact_stored`]), so the friction
+//!   work is part of the dissipated energy.
 
 use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Traction};
 
@@ -190,8 +193,8 @@ pub fn interface_stored(points: &[InterfacePoint], law: &dyn CohesiveLaw, trial:
     for (ip, p) in points.iter().enumerate() {
         let psi = match p.kind {
             PointKind::Cohesive => law.stored_energy(&gaps[ip], &trial[ip].state),
-            // Contact is a linear penalty: ½ T·g.
-            PointKind::Contact => 0.5 * trial[ip].traction.dot(&gaps[ip]),
+            // The normal penalty and, with friction, the stick spring (½ T·g without friction).
+            PointKind::Contact => super::interface::contact_stored(&trial[ip], &gaps[ip]),
         };
         e += p.area * p.factor * psi;
     }

@@ -28,7 +28,8 @@ use super::mesh::{Mesh, NONE};
 pub enum PointKind {
     /// The cohesive law of the run.
     Cohesive,
-    /// Frictionless contact only (a pre-crack): normal penalty in compression, free otherwise.
+    /// Contact only (a pre-crack): normal penalty in compression, free otherwise; with Coulomb
+    /// friction when the problem's `contact_friction` is positive ([`frictional_contact`]).
     Contact,
 }
 
@@ -191,4 +192,71 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess:
 pub fn contact(gap: &Gap, k: f64) -> LawEval {
     let (t, kt) = if gap[0] < 0.0 { (k * gap[0], k) } else { (0.0, 0.0) };
     LawEval { traction: Traction::new(t, 0.0), tangent: Tangent::new(kt, 0.0, 0.0, 0.0), state: LawState::default() }
+}
+
+/// Recoverable energy per unit area of a contact point (N/mm) at `gap` with the evaluation `ev`:
+/// `½ T·(g − (0, s))`, `s` the slip in `ev`'s state (0 without friction, where this is `½ T·g`).
+/// The normal penalty stores `½ k g_n²` in closure; the stick spring `T_t² / (2k)`.
+pub fn contact_stored(ev: &LawEval, gap: &Gap) -> f64 {
+    let slip = ev.state.history[SLIP];
+    if slip == 0.0 {
+        0.5 * ev.traction.dot(gap)
+    } else {
+        0.5 * ev.traction.dot(&(gap - Gap::new(0.0, slip)))
+    }
+}
+
+/// Index of the slip `s` (mm) in a contact point's [`LawState::history`]: the tangential gap at
+/// which its stick spring is unstretched.
+pub const SLIP: usize = 0;
+/// Index of the friction work dissipated at a contact point so far, per unit area (N/mm), in its
+/// [`LawState::history`].
+pub const FRICTION_WORK: usize = 1;
+
+/// Index of the magnitude of the shear `|T_t|` (MPa) a contact point carried at its last
+/// evaluation, in its [`LawState::history`] (the start of the next step's friction work).
+pub const SHEAR: usize = 2;
+
+/// Contact with Coulomb friction of coefficient `mu` (dimensionless), regularised by a stick
+/// spring: normal penalty `k` (MPa/mm) on closure as in [`contact`], and a tangential spring of
+/// the same stiffness `k` between the tangential gap `g_t` and the slip `s` of the committed
+/// `state`, capped at the Coulomb limit `μ p` (`p = −k g_n`, the contact pressure in MPa).
+///
+/// The update is the return mapping of rigid-plastic slip (Wriggers, *Computational Contact
+/// Mechanics*, §5.2): the trial shear `τ* = k (g_t − s)` is the traction while `|τ*| ≤ μ p`
+/// (stick, tangent `∂T_t/∂g_t = k`); beyond, the point slips with `T_t = μ p sign τ*`, the slip
+/// moves to `g_t − T_t/k` and the tangent is `∂T_t/∂g_n = −μ k sign τ*` (unsymmetric, so
+/// Newton stays quadratic while points slip). An open point (`g_n ≥ 0`) carries nothing and its
+/// slip follows the gap. The dissipated work `½ (|T_t|₀ + μ p) |Δs|` (trapezoidal rule from the
+/// committed shear [`SHEAR`]) accumulates in the state ([`FRICTION_WORK`]); the recoverable
+/// energy is [`contact_stored`].
+///
+/// The stick spring stands for the elastic compliance of the asperities: with `k` of the order of
+/// the law's penalty, stick slips are ~`μ p / k`, below 10⁻³ mm for the pressures of an ENF.
+pub fn frictional_contact(gap: &Gap, state: &LawState, k: f64, mu: f64) -> LawEval {
+    let mut out = *state;
+    if gap[0] >= 0.0 {
+        // Open: no traction, and the faces meet again unstressed wherever they are.
+        out.history[SLIP] = gap[1];
+        out.history[SHEAR] = 0.0;
+        return LawEval { traction: Traction::zeros(), tangent: Tangent::zeros(), state: out };
+    }
+    let (tn, dnn) = (k * gap[0], k);
+    let limit = mu * (-tn);
+    let s0 = state.history[SLIP];
+    let trial = k * (gap[1] - s0);
+    let (tt, dtn, dtt) = if trial.abs() <= limit {
+        (trial, 0.0, k) // stick
+    } else {
+        let sign = trial.signum();
+        let tt = sign * limit;
+        let s1 = gap[1] - tt / k;
+        out.history[SLIP] = s1;
+        // Trapezoidal rule on the shear over the slip increment (second order in the step, as
+        // the ledger's work): from the committed |T_t| to the Coulomb limit.
+        out.history[FRICTION_WORK] += 0.5 * (state.history[SHEAR] + limit) * (s1 - s0).abs();
+        (tt, -mu * k * sign, 0.0)
+    };
+    out.history[SHEAR] = tt.abs();
+    LawEval { traction: Traction::new(tn, tt), tangent: Tangent::new(dnn, 0.0, dtn, dtt), state: out }
 }

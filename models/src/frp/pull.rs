@@ -429,7 +429,16 @@ impl FrpPull {
         }
         let control = mesh.dofs(1, 0)[0];
         let springs = vec![Spring { i: control, j: NONE, k: self.reference_stiffness(), ci: 1.0 }];
-        Ok(FeProblem { mesh, points, springs, fixed, control, large_rotation: false, contact_stiffness: 0.0 })
+        Ok(FeProblem {
+            mesh,
+            points,
+            springs,
+            fixed,
+            control,
+            large_rotation: false,
+            contact_stiffness: 0.0,
+            contact_friction: 0.0,
+        })
     }
 
     /// Stiffness of the reference spring at the loaded end, `E_f A_f/((1 + α) L)` (N/mm); see the
