@@ -27,6 +27,11 @@ const TRANSFER_WORSE: f64 = -0.1;
 /// more than the data show. Without a floor (a model with no reference, or `--no-model-form`)
 /// there is no such leftover, and the evidence alone decides.
 pub const MIN_SHARE_AT_NOISE: f64 = 0.1;
+/// A candidate that also qualifies as a cause and removes at least this fraction of what the named
+/// cause removes is a rival: the refits do not decide between them (e.g. on ENF-04 a shear
+/// compliance removes 54 % and a crack-length offset 52 %), and the verdict says so rather than
+/// letting two per cent pick one.
+pub const RIVAL_SHARE: f64 = 0.9;
 
 /// What kind of answer the diagnosis gives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -53,6 +58,9 @@ pub struct Outcome {
     pub transfer_shrinkage: Option<f64>,
     /// Candidates the data can hardly tell from the cause (cosine above the confusable level).
     pub confusable_with: Vec<String>,
+    /// Other candidates that qualify as a cause and whose refits remove nearly as much
+    /// ([`RIVAL_SHARE`] of the cause's share or more), most first, with the share each removes.
+    pub rivals: Vec<(String, f64)>,
     /// Whether the misfit left with the cause still exceeds the noise, over all readings or in
     /// its structure along the curves: more is missing.
     pub more_missing: bool,
@@ -85,7 +93,7 @@ pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusab
         reasons.push(format!("base runs stopped early: {}", base.failures.join("; ")));
     }
     let provisional = !reasons.is_empty();
-    let mut best: Option<&CandidateResult> = None;
+    let mut qualified: Vec<&CandidateResult> = Vec::new();
     for c in candidates {
         let Some(r) = &c.refit else { continue };
         if r.delta_bic > -EVIDENCE {
@@ -108,13 +116,20 @@ pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusab
             ));
             continue;
         }
-        if best.and_then(|b| b.refit.as_ref()).is_none_or(|b| r.shrinkage > b.shrinkage) {
-            best = Some(c);
-        }
+        qualified.push(c);
     }
+    let share = |c: &CandidateResult| c.refit.as_ref().map_or(f64::NEG_INFINITY, |r| r.shrinkage);
+    // The first of the largest shares, as candidates are listed (stable under ties).
+    let best = qualified.iter().copied().reduce(|b, c| if share(c) > share(b) { c } else { b });
     match best {
         Some(c) => {
             let r = c.refit.as_ref().expect("refitted");
+            let mut rivals: Vec<(String, f64)> = qualified
+                .iter()
+                .filter(|q| q.name != c.name && share(q) >= RIVAL_SHARE * r.shrinkage)
+                .map(|q| (q.name.clone(), share(q)))
+                .collect();
+            rivals.sort_by(|a, b| b.1.total_cmp(&a.1));
             let confusable_with = confusable
                 .iter()
                 .filter(|p| p.a == c.name || p.b == c.name)
@@ -126,6 +141,7 @@ pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusab
                 shrinkage: Some(r.shrinkage),
                 transfer_shrinkage: c.transfer.iter().find_map(|t| t.shrinkage),
                 confusable_with,
+                rivals,
                 // Above the noise over all readings, or with structure along the curves that the
                 // χ² of all readings averages away (a thin misfit over many readings).
                 more_missing: chi2_survival(r.chi2_reestimated.unwrap_or(r.chi2), refit_dof(n, c)) <= NOISE_LEVEL
@@ -140,6 +156,7 @@ pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusab
             shrinkage: None,
             transfer_shrinkage: None,
             confusable_with: Vec::new(),
+            rivals: Vec::new(),
             more_missing: false,
             provisional,
             reasons,
@@ -257,6 +274,13 @@ fn cause_text(out: &mut String, base: &BaseFit, candidates: &[CandidateResult], 
     }
     if !outcome.confusable_with.is_empty() {
         out.push_str(&format!(" These data can hardly tell it from {}.", outcome.confusable_with.join(", ")));
+    }
+    if !outcome.rivals.is_empty() {
+        let list: Vec<String> = outcome.rivals.iter().map(|(name, s)| format!("{name} ({})", pct(*s))).collect();
+        out.push_str(&format!(
+            " Nearly as much is removed by {}: the refits do not decide between them, other data (a crack length, another specimen) would.",
+            list.join(", ")
+        ));
     }
     if outcome.more_missing {
         out.push_str(" Even with it the misfit stays above the noise, or keeps a structure along the curves that noise does not have: more is missing.");
@@ -386,5 +410,30 @@ mod tests {
         // So is it without a model-form floor, which leaves nothing to soak up.
         let no_floor = BaseFit { model_form_accounted: false, ..base(0.98) };
         assert_eq!(decide(&no_floor, 400, &small, &[]).cause.as_deref(), Some("a"));
+    }
+
+    #[test]
+    fn a_rival_that_removes_nearly_as_much_is_named_beside_the_cause() {
+        // ENF-04's near tie: 54 % and 52 %; a third removing 30 % is no rival.
+        let cs = [
+            candidate("shear", Some((400.0, 0.54, -400.0)), Some(0.84)),
+            candidate("offset", Some((410.0, 0.52, -380.0)), Some(0.85)),
+            candidate("toe", Some((600.0, 0.30, -100.0)), None),
+        ];
+        let o = decide(&base(2.0), 400, &cs, &[]);
+        assert_eq!(o.cause.as_deref(), Some("shear"));
+        assert_eq!(o.rivals, [("offset".to_string(), 0.52)]);
+        // A rival must qualify as a cause itself: one that predicts withheld data worse is not.
+        let cs = [
+            candidate("shear", Some((400.0, 0.54, -400.0)), None),
+            candidate("offset", Some((410.0, 0.52, -380.0)), Some(-0.5)),
+        ];
+        assert!(decide(&base(2.0), 400, &cs, &[]).rivals.is_empty());
+        // A clear winner has none.
+        let cs = [
+            candidate("shear", Some((400.0, 0.54, -400.0)), None),
+            candidate("offset", Some((600.0, 0.45, -200.0)), None),
+        ];
+        assert!(decide(&base(2.0), 400, &cs, &[]).rivals.is_empty());
     }
 }
