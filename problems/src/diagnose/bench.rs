@@ -88,6 +88,9 @@ pub struct CaseResult {
     /// Candidates the verdict says the data can hardly tell from the cause.
     #[serde(default)]
     pub confusable_with: Vec<String>,
+    /// Candidates the verdict names beside the cause as removing nearly as much.
+    #[serde(default)]
+    pub rivals: Vec<String>,
     /// Whether the verdict is provisional.
     #[serde(default)]
     pub provisional: bool,
@@ -200,6 +203,7 @@ fn case(
         kind: String::new(),
         more_missing: false,
         confusable_with: Vec::new(),
+        rivals: Vec::new(),
         provisional: false,
         reasons: Vec::new(),
         refits: Vec::new(),
@@ -349,6 +353,7 @@ fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
     out.kind = serde_json::to_value(d.outcome.kind).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default();
     out.more_missing = d.outcome.more_missing;
     out.confusable_with = d.outcome.confusable_with.clone();
+    out.rivals = d.outcome.rivals.iter().map(|(name, _)| name.clone()).collect();
     out.provisional = d.outcome.provisional;
     out.reasons = d.outcome.reasons.clone();
     out.refits = d
