@@ -12,7 +12,7 @@
 mod fe_support;
 use czid_core::{columns, CohesiveLaw, ForwardModel, LawState, Record};
 use czid_models::enf::Enf;
-use czid_models::fe::interface::{FRICTION_WORK, SLIP};
+use czid_models::fe::interface::{contact_stored, FRICTION_WORK, SLIP};
 use czid_models::fe::newton::{Newton, NewtonSettings};
 use czid_models::fe::PointKind;
 use czid_models::laws::Bilinear;
@@ -185,7 +185,7 @@ fn loading_branch(mu: f64, deflection: f64, steps: usize) -> Branch {
                 stored[i] = law.stored_energy(g, s);
             }
             PointKind::Contact => {
-                stored[i] = 0.5 * ev.traction.dot(g);
+                stored[i] = contact_stored(ev, g);
                 let (pressure, tau) = (-ev.traction[0], ev.traction[1].abs());
                 assert!(s.history[FRICTION_WORK] >= 0.0, "negative friction work at point {i}");
                 b.friction_work += w * s.history[FRICTION_WORK];

@@ -375,19 +375,12 @@ impl Assembler {
 
     /// Recoverable energy of the interface integrated as the forces are: the segments' `∫ ½ T·g`
     /// and the nodal rule for the points outside segments (N·mm). `stored` holds each point's
-    /// own recoverable energy per unit area; with friction, a contact point's is taken from its
-    /// last evaluation instead ([`interface::contact_stored`]: its stick spring stores
-    /// `T_t²/(2k)`, not `½ T_t g_t`).
+    /// own recoverable energy per unit area.
     pub fn interface_stored(&self, p: &FeProblem, stored: &[f64]) -> f64 {
         let mut e: f64 = self.segment_stored.iter().sum();
         for (i, pt) in p.points.iter().enumerate() {
             if !self.covered[i] {
-                let psi = if pt.kind == PointKind::Contact && p.contact_friction != 0.0 {
-                    interface::contact_stored(&self.trial[i], &self.gaps[i])
-                } else {
-                    stored[i]
-                };
-                e += pt.area * pt.factor * psi;
+                e += pt.area * pt.factor * stored[i];
             }
         }
         e

@@ -467,7 +467,7 @@ impl<'a> WholeMesh<'a> {
                 let g = &self.nw.asm.gaps[i];
                 *v = match p.points[i].kind {
                     PointKind::Cohesive => law.stored_energy(g, &self.cur.states[i]),
-                    PointKind::Contact => 0.5 * self.nw.asm.trial[i].traction.dot(g),
+                    PointKind::Contact => super::interface::contact_stored(&self.nw.asm.trial[i], g),
                 };
             }
             self.nw.asm.interface_stored(p, &self.measures.point_stored)
