@@ -543,6 +543,8 @@ fn shift_predictor(p: &FeProblem, cur: &[f64], trial: &mut [f64], x: f64, da: f6
     use super::mesh::NONE;
     let xs = &p.mesh.x;
     let nn = xs.len();
+    // Per node [u, w, θ, s]: the axial displacement only under small rotations (see above).
+    let first = usize::from(p.large_rotation);
     for i in 0..nn {
         if (xs[i] - x).abs() > zone {
             continue;
@@ -552,8 +554,6 @@ fn shift_predictor(p: &FeProblem, cur: &[f64], trial: &mut [f64], x: f64, da: f6
         let t = ((xt - xs[j]) / (xs[j + 1] - xs[j])).clamp(0.0, 1.0);
         for layer in 0..p.mesh.layers.len() {
             let (di, dj, dk) = (p.mesh.dofs(layer, i), p.mesh.dofs(layer, j), p.mesh.dofs(layer, j + 1));
-            // [u, w, θ, s]: the axial displacement only under small rotations (see above).
-            let first = usize::from(p.large_rotation);
             for c in first..4 {
                 if di[c] != NONE && dj[c] != NONE && dk[c] != NONE && di[c] != p.control {
                     trial[di[c]] = (1.0 - t) * cur[dj[c]] + t * cur[dk[c]];
