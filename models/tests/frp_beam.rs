@@ -123,6 +123,29 @@ fn configuration_errors_name_the_field() {
 }
 
 #[test]
+fn a_run_stopped_at_a_deflection_is_the_full_run_up_to_its_first_crossing() {
+    let law = FrpBeam::table8_law().unwrap();
+    let full = FrpBeam::paper().unwrap().run(&law, false).unwrap();
+    let mut beam = FrpBeam::paper().unwrap();
+    // On the load drop after the peak (the whole run goes on to complete debonding beyond 24 mm).
+    beam.control.max_deflection = Some(24.0);
+    let stopped = beam.run(&law, false).unwrap();
+    assert_eq!(stopped.end, RunEnd::MaxDeflection);
+    let d = full.record.column(columns::DISPLACEMENT).unwrap();
+    let first = d.iter().position(|&v| v >= 24.0).expect("the full run passes 24 mm");
+    assert!(first + 1 < full.record.rows(), "the full run ends at its first crossing");
+    // The same states, bit for bit, up to and including the first reaching 24 mm; none after.
+    assert_eq!(stopped.record.rows(), first + 1);
+    for name in [columns::DISPLACEMENT, columns::LOAD, columns::DEBONDED_LENGTH, columns::EXTERNAL_WORK] {
+        let (a, b) = (stopped.record.column(name).unwrap(), full.record.column(name).unwrap());
+        assert_eq!(a, &b[..=first], "{name}");
+    }
+    beam.control.max_deflection = Some(-1.0);
+    let err = beam.validate().unwrap_err().to_string();
+    assert!(err.contains("control.max_deflection"), "{err}");
+}
+
+#[test]
 fn ic_debonding_starts_at_high_moment_and_runs_to_the_plate_end_through_the_load_drop() {
     let beam = FrpBeam::paper().unwrap();
     let run = full_run(10.0, 0.05);

@@ -53,8 +53,10 @@
 //!   another interface point fails.
 //! * **Run end**: complete debonding of the modelled side (the failed stretch of the interface
 //!   that ends at the plate end reaches back to where debonding started),
-//!   crushing of the concrete (top fibre strain beyond `ε_cu` anywhere), or
-//!   `control.max_elongation`, whichever comes first ([`RunEnd`]).
+//!   crushing of the concrete (top fibre strain beyond `ε_cu` anywhere),
+//!   `control.max_elongation`, or the mid-span deflection `control.max_deflection` if one is
+//!   given (a test's last reading: the run need not go on beyond it), whichever comes first
+//!   ([`RunEnd`]).
 //!
 //! Small rotations and small strains throughout (the deflections stay below span/40).
 //!
@@ -154,6 +156,13 @@ pub struct BeamControl {
     /// tolerance (a step of that size is taken whatever the difference: an unstable stretch of the
     /// path, crossed at nearly fixed elongation).
     pub min_step_fraction: f64,
+    /// Mid-span deflection (mm) at which the run ends, if it has not ended before: the state
+    /// recorded where the deflection first reaches it is the last. A test that stopped at a
+    /// known deflection need not be followed beyond it (the states after the first crossing are
+    /// never compared with the test; the event "debonded length at the end of the test" reads
+    /// the first crossing). `None`: the run goes on to complete debonding.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_deflection: Option<f64>,
 }
 
 impl Default for BeamControl {
@@ -166,6 +175,7 @@ impl Default for BeamControl {
             tolerance: 1e-9,
             damage_tolerance: 0.05,
             min_step_fraction: 1.0 / 64.0,
+            max_deflection: None,
         }
     }
 }
@@ -209,6 +219,8 @@ pub enum RunEnd {
     ConcreteCrushing,
     /// `control.max_elongation` was reached.
     MaxElongation,
+    /// The mid-span deflection reached `control.max_deflection`.
+    MaxDeflection,
 }
 
 /// Where the interface first failed.
@@ -385,6 +397,9 @@ impl FrpBeam {
                 c.min_step_fraction,
                 "must lie in (0, 1]",
             ));
+        }
+        if let Some(d) = c.max_deflection {
+            require_positive(OWNER, "control.max_deflection", d)?;
         }
         self.effects.validate(OWNER)?;
         // The effects must leave valid materials.
@@ -603,6 +618,10 @@ impl FrpBeam {
                     }
                     debonded_before = true;
                 }
+            }
+            if c.max_deflection.is_some_and(|d| w(0) >= d) {
+                end = RunEnd::MaxDeflection;
+                return true;
             }
             let crushed = (0..layout.support).any(|i| {
                 let (a, b) = (p.mesh.dofs(0, i), p.mesh.dofs(0, i + 1));
