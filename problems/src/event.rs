@@ -11,6 +11,7 @@
 //! unit = "mm"                         # mm, m, in (lengths); N, kN, lbf (the peak load)
 //! fraction = 0.98                     # onset only: of the peak load (default 0.98)
 //! weight = 1.0                        # optional factor on the term's α (default 1)
+//! uncertainty = 10.0                  # optional: the reading's standard uncertainty, in `unit`
 //!
 //! [[experiment.event]]
 //! kind = "debonded_length_at_end"
@@ -30,6 +31,13 @@
 //! Each event is one term of the objective, `φ = (y − ŷ)/|y|` (its relative error), weighted like
 //! a curve: `weights = "balanced"` gives it the same share at the initial guess as every other
 //! term, explicit weights give it `events = α_E` (default 1); `weight` multiplies either.
+//!
+//! **Uncertainty.** A measured event is one reading, so the data cannot say how well it is known;
+//! `uncertainty` says it (e.g. 10 mm for a debonded length read off a plate with a ruler). It does
+//! not change the objective. After an identification, an event that the fit misses by more than
+//! [`MISSED_EVENT_FACTOR`] times its uncertainty is named in a warning and makes every verdict
+//! provisional: the fit is not at the level of the data (a local minimum, or a model-form
+//! difference), and standard errors computed there describe that misfit, not the parameters.
 
 use crate::data::{ForceUnit, LengthUnit};
 use czid_core::event::{DisplacementAtLoad, EndOfTest, OnsetOfDebonding, PeakLoad};
@@ -95,7 +103,14 @@ pub struct EventSpec {
     /// Unit of `load` (default N).
     #[serde(default)]
     pub load_unit: ForceUnit,
+    /// Standard uncertainty of the reading, in `unit` (optional; see the module documentation).
+    #[serde(default)]
+    pub uncertainty: Option<f64>,
 }
+
+/// How many uncertainties an identified fit may miss a measured event by before it is reported
+/// (a normally distributed reading lies within 3 standard uncertainties 99.7 % of the time).
+pub const MISSED_EVENT_FACTOR: f64 = 3.0;
 
 /// A checked event with its value in N or mm.
 #[derive(Clone, Debug, PartialEq)]
@@ -108,6 +123,8 @@ pub struct MeasuredEvent {
     pub value: f64,
     /// Factor on the term's weight.
     pub weight: f64,
+    /// Standard uncertainty of the reading (N or mm), if given.
+    pub uncertainty: Option<f64>,
     /// The response it is compared with.
     pub response: EventResponse,
 }
@@ -219,8 +236,18 @@ impl EventSpec {
                 )
             }
         };
+        let uncertainty = match self.uncertainty {
+            Some(u) if u.is_finite() && u > 0.0 => Some(u * factor),
+            Some(u) => {
+                return Err(CzError::config(
+                    field("uncertainty"),
+                    format!("{u} must be a positive, finite value in `{}`", self.unit),
+                ))
+            }
+            None => None,
+        };
         let name = self.name.clone().unwrap_or_else(|| kind.key().to_string());
-        Ok(MeasuredEvent { name, kind, value, weight, response })
+        Ok(MeasuredEvent { name, kind, value, weight, uncertainty, response })
     }
 }
 
@@ -245,6 +272,11 @@ mod tests {
         assert_eq!(e.response, EventResponse::AtLoad(DisplacementAtLoad { load: 200_000.0 }));
         let e = spec("kind = \"debonded_length_at_onset\"\nvalue = 436\nunit = \"mm\"").check("p", 1.0).unwrap();
         assert_eq!(e.response, EventResponse::Onset(OnsetOfDebonding { fraction: 0.98 }));
+        assert_eq!(e.uncertainty, None);
+        let e = spec("kind = \"debonded_length_at_onset\"\nvalue = 0.436\nunit = \"m\"\nuncertainty = 0.01")
+            .check("p", 1.0)
+            .unwrap();
+        assert_eq!(e.uncertainty, Some(10.0));
     }
 
     #[test]
@@ -259,6 +291,8 @@ mod tests {
             ("kind = \"displacement_at_load\"\nvalue = 1\nunit = \"mm\"", "`load`"),
             ("kind = \"displacement_at_load\"\nvalue = 1\nunit = \"mm\"\nload = 0", "`load`"),
             ("kind = \"debonded_length_at_onset\"\nvalue = 1\nunit = \"mm\"\nat = 3", "`at`"),
+            ("kind = \"peak_load\"\nvalue = 1\nunit = \"N\"\nuncertainty = 0", "`uncertainty`"),
+            ("kind = \"peak_load\"\nvalue = 1\nunit = \"N\"\nuncertainty = -3", "`uncertainty`"),
         ];
         for (text, name) in cases {
             let e = spec(text).check("problem.toml, experiment 1, event 1", 10.0).unwrap_err().to_string();

@@ -1,8 +1,9 @@
 //! `identify`: run an optimizer on a problem file and write the identified parameters, fits,
 //! history and plots. `simulate`: run the forward models at the initial values.
 
+use crate::event::MISSED_EVENT_FACTOR;
 use crate::identifiability::{assess, Verdict};
-use crate::identification::{Identification, Outcome};
+use crate::identification::{Identification, Outcome, RmsError};
 use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
 use crate::problem_file::LoadedProblem;
@@ -374,6 +375,9 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     let outcome = id.simulate(&x)?;
     let mut warnings: Vec<String> = outcome.failures.clone();
     warnings.extend(short_runs(problem, &outcome));
+    let errors = id.term_errors(&outcome)?;
+    let missed = missed_events(problem, &errors);
+    let fit_short = !missed.is_empty();
     let why = if partial { None } else { unconverged(&method, &result, budget.evaluations, iterations.0) };
     let converged = !partial && why.is_none();
     if let Some(why) = why {
@@ -381,6 +385,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
             "budget exhausted before convergence: {why}; the values and their verdicts are provisional (raise --budget)"
         ));
     }
+    warnings.extend(missed);
     let assessment = assess(&id, &result.best_x)?;
     let mut parameters = BTreeMap::new();
     for (i, p) in id.space().parameters().iter().enumerate() {
@@ -398,9 +403,11 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
                 standard_error: assessment.standard_errors[i],
                 verdict: match describe_with_error(verdict, id.space(), x[i], assessment.standard_errors[i]) {
                     // Data that do not determine a parameter do not at any point.
-                    v if converged || matches!(verdict, Verdict::NotDetermined) => v,
+                    v if matches!(verdict, Verdict::NotDetermined) => v,
                     v if partial => format!("{v}, provisional: the run was interrupted"),
-                    v => format!("{v}, provisional: budget exhausted before convergence"),
+                    v if !converged => format!("{v}, provisional: budget exhausted before convergence"),
+                    v if fit_short => format!("{v}, provisional: the fit misses a measured event"),
+                    v => v,
                 },
             },
         );
@@ -419,7 +426,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         objective_terms,
         misfit: id.term_values(&outcome)?.into_iter().collect(),
         weights: id.weights().into_iter().collect(),
-        rms_error: id.term_errors(&outcome)?.into_iter().collect(),
+        rms_error: errors.into_iter().collect(),
         evaluations: result.evaluations,
         failed_evaluations: result.failures,
         wall_seconds: wall,
@@ -437,6 +444,34 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
     write_fits(problem, &outcome, out, "fit")?;
     convergence_plot(&result, out)?;
     Ok(res)
+}
+
+/// Measured events that the fit misses by more than [`MISSED_EVENT_FACTOR`] times their stated
+/// uncertainty (`errors`: [`Identification::term_errors`] at the fit), said in words.
+pub fn missed_events(problem: &LoadedProblem, errors: &[(String, RmsError)]) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in &problem.experiments {
+        for ev in &e.events {
+            let Some(u) = ev.uncertainty else { continue };
+            let term = format!("E:{}:{}", e.name, ev.name);
+            let Some((_, err)) = errors.iter().find(|(name, _)| *name == term) else { continue };
+            if err.value > MISSED_EVENT_FACTOR * u {
+                let unit = ev.unit();
+                out.push(format!(
+                    "the fit misses `{}` of `{}` (measured {:.4} {unit}) by {:.4} {unit}, {:.1} times its stated \
+                     uncertainty of {u:.4} {unit}: the fit is not at the level of the data (a local minimum, or a \
+                     model-form difference) and the verdicts are provisional; a global method (miga, hybrid) or \
+                     another initial guess may find a better fit",
+                    ev.name,
+                    e.name,
+                    ev.value,
+                    err.value,
+                    err.value / u
+                ));
+            }
+        }
+    }
+    out
 }
 
 /// Experiments whose simulation ends before their last reading: the readings beyond are compared

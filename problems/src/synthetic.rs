@@ -251,6 +251,8 @@ impl TruthFile {
                 at: (e.kind == EventKind::DebondedLengthAtEnd).then_some(last),
                 load: e.load,
                 load_unit: Default::default(),
+                // The reading's error and its rounding (uniform over one resolution step).
+                uncertainty: Some((e.sd * e.sd + e.resolution * e.resolution / 12.0).sqrt()).filter(|u| *u > 0.0),
             };
             let owner = format!("truth file, event {}", j + 1);
             let measured = spec.check(&owner, last)?;

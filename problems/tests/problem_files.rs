@@ -464,6 +464,40 @@ fn measured_events_are_terms_of_the_objective() {
     assert_eq!(w[2..].iter().map(|(_, w)| *w).collect::<Vec<_>>(), [2.0, 1.0]);
 }
 
+/// An event the fit cannot meet (the displacement at 80 N read as 0.7 mm where the curve says
+/// 0.5 mm) is named, with its misfit in uncertainties, and makes the verdicts provisional when its
+/// stated uncertainty is small; a generous uncertainty, or none, says nothing.
+#[test]
+fn an_event_missed_by_more_than_three_uncertainties_is_said_and_qualifies_the_verdicts() {
+    use czid_problems::identify::{identify, RunOptions};
+    use czid_problems::output::OutputDir;
+    let run = |name: &str, uncertainty: &str| {
+        let text = with_events(uncertainty).replace("value = 0.5\n", "value = 0.7\n");
+        let dir = setup_dir(name, &text);
+        let p = read(&dir).unwrap();
+        let out = OutputDir::create(&dir.join("out"), true, false).unwrap();
+        let opts =
+            RunOptions { optimizer: Some("levenberg-marquardt".into()), budget: Some(500), ..Default::default() };
+        identify(&p, &opts, &out).unwrap()
+    };
+    let tight = run("missed-tight", "uncertainty = 0.01");
+    assert!(tight.converged);
+    let missed = tight.rms_error["E:patch:displacement_at_load"].value;
+    assert!(missed > 0.03, "the fit meets the event ({missed} mm)");
+    let said: Vec<&String> = tight.warnings.iter().filter(|w| w.starts_with("the fit misses")).collect();
+    assert_eq!(said.len(), 1, "{:?}", tight.warnings);
+    assert!(said[0].contains("`displacement_at_load` of `patch`"), "{}", said[0]);
+    assert!(said[0].contains(&format!("{:.1} times its stated uncertainty", missed / 0.01)), "{}", said[0]);
+    let verdict = &tight.parameters["law.stiffness"].verdict;
+    assert!(verdict.ends_with("provisional: the fit misses a measured event"), "{verdict}");
+    for (name, extra) in [("missed-loose", "uncertainty = 1.0"), ("missed-none", "")] {
+        let res = run(name, extra);
+        assert!(!res.warnings.iter().any(|w| w.starts_with("the fit misses")), "{name}: {:?}", res.warnings);
+        assert!(!res.parameters["law.stiffness"].verdict.contains("provisional"), "{name}");
+        assert_eq!(res.parameters["law.stiffness"].value, tight.parameters["law.stiffness"].value, "{name}");
+    }
+}
+
 #[test]
 fn bad_events_are_named_with_their_field() {
     let cases = [
@@ -473,6 +507,7 @@ fn bad_events_are_named_with_their_field() {
         ("event-kind", with_events("").replace("\"peak_load\"", "\"peak\""), "peak_load"),
         ("event-field", with_events("sigma = 1.0"), "sigma"),
         ("event-twice", with_events("name = \"peak_load\""), "two events of this experiment are named `peak_load`"),
+        ("event-uncertainty", with_events("uncertainty = -0.1"), "event 2 (displacement_at_load): `uncertainty`"),
     ];
     for (name, text, expect) in cases {
         let msg = read(&setup_dir(name, &text)).unwrap_err().to_string();
