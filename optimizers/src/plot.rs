@@ -69,7 +69,7 @@ impl Series {
     pub fn points(label: &str, x: Vec<f64>, y: Vec<f64>) -> Self {
         Series { label: label.into(), x, y, mark: Mark::Points, band: None }
     }
-    /// Adds a shaded band between `lower` and `upper`.
+    /// Adds a band between `lower` and `upper`: shaded around a line, error bars on markers.
     pub fn with_band(mut self, lower: Vec<f64>, upper: Vec<f64>) -> Self {
         self.band = Some((lower, upper));
         self
@@ -287,7 +287,16 @@ impl Figure {
         let ok = |x: f64, y: f64| x.is_finite() && y.is_finite() && (!self.log_y || y > 0.0);
         for (i, s) in self.series.iter().enumerate() {
             let color = PALETTE[i % PALETTE.len()];
-            if let Some((lo, hi)) = &s.band {
+            if let (Some((lo, hi)), Mark::Points) = (&s.band, s.mark) {
+                // Markers carry their band as error bars: one vertical bar per point.
+                let bars =
+                    s.x.iter().zip(lo.iter().zip(hi)).filter(|(x, (a, b))| ok(**x, **a) && ok(**x, **b) && a < b);
+                chart
+                    .draw_series(
+                        bars.map(|(&x, (&a, &b))| PathElement::new(vec![(x, a), (x, b)], color.stroke_width(2))),
+                    )
+                    .map_err(err)?;
+            } else if let Some((lo, hi)) = &s.band {
                 let mut poly: Vec<(f64, f64)> =
                     s.x.iter().zip(hi).filter(|(x, y)| ok(**x, **y)).map(|(x, y)| (*x, *y)).collect();
                 poly.extend(s.x.iter().zip(lo).rev().filter(|(x, y)| ok(**x, **y)).map(|(x, y)| (*x, *y)));
@@ -379,6 +388,19 @@ mod tests {
             assert!(std::fs::metadata(&p).unwrap().len() > 1000, "{name} is too small to hold a plot");
         }
         assert!(fig.save(&dir.join("f.pdf")).is_err());
+        // Markers with a band get one error bar per point (a drawn segment each), not a shaded area.
+        let marked = |band: bool| {
+            let s = Series::points("b", vec![1.0, 2.0], vec![5.0, 7.0]);
+            let s = if band { s.with_band(vec![4.0, 6.5], vec![6.0, 7.5]) } else { s };
+            let p = dir.join(format!("bars-{band}.svg"));
+            Figure::new("t", "x", "y").with(s).save(&p).unwrap();
+            let text = std::fs::read_to_string(&p).unwrap();
+            // Strokes of the series' width: its legend entry, and the bars.
+            (text.matches("stroke-width=\"2\"").count(), text.matches("<polygon").count())
+        };
+        let (plain, bars) = (marked(false), marked(true));
+        assert_eq!(plain, (1, 0));
+        assert_eq!(bars, (3, 0));
         let log = Figure::new("t", "x", "y").log_y().with(Series::line("a", vec![0.0, 1.0], vec![1.0, 1e-3]));
         log.save(&dir.join("log.png")).unwrap();
         if std::env::var_os("CZID_KEEP_PLOTS").is_none() {

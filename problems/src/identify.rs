@@ -584,8 +584,9 @@ pub(crate) fn write_fits(problem: &LoadedProblem, outcome: &Outcome, out: &Outpu
     Ok(())
 }
 
-/// The experiment's scalar events, test beside model, one figure per unit (`-events.png` for
-/// lengths and displacements in mm, `-events-load.png` for loads in N); nothing without events.
+/// The experiment's scalar events, test (with bars of ± its stated uncertainty) beside model, one
+/// figure per unit (`-events.png` for lengths and displacements in mm, `-events-load.png` for
+/// loads in N); nothing without events.
 fn events_plot(e: &crate::data::Experiment, record: &czid_core::Record, out: &OutputDir, stem: &str) -> Result<()> {
     for (unit, file) in [("mm", "events"), ("N", "events-load")] {
         let mine: Vec<_> = e.events.iter().filter(|v| v.unit() == unit).collect();
@@ -595,6 +596,14 @@ fn events_plot(e: &crate::data::Experiment, record: &czid_core::Record, out: &Ou
         let names: Vec<String> = mine.iter().map(|v| v.name.clone()).collect();
         let at: Vec<f64> = (1..=mine.len()).map(|i| i as f64).collect();
         let test: Vec<f64> = mine.iter().map(|v| v.value).collect();
+        // The readings' stated uncertainties as ± one-uncertainty bars.
+        let spread = |sign: f64| mine.iter().map(|v| v.value + sign * v.uncertainty.unwrap_or(0.0)).collect();
+        let test_series = Series::points("test", at.clone(), test);
+        let test_series = if mine.iter().any(|v| v.uncertainty.is_some()) {
+            test_series.with_band(spread(-1.0), spread(1.0))
+        } else {
+            test_series
+        };
         // An event the model does not reach (a run that stopped early) is left out of the model's
         // points rather than drawn at a made-up value.
         let (model_at, model): (Vec<f64>, Vec<f64>) = mine
@@ -605,7 +614,7 @@ fn events_plot(e: &crate::data::Experiment, record: &czid_core::Record, out: &Ou
             })
             .unzip();
         Figure::new(&format!("{}: events", e.name), "event", &format!("value ({unit})"))
-            .with(Series::points("test", at, test))
+            .with(test_series)
             .with(Series::points("model", model_at, model))
             .with_categories(&names)
             .save(&out.file(&format!("{stem}-{file}.png")))?;
