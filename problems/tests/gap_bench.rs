@@ -38,9 +38,37 @@ fn a_resumed_run_reuses_the_cases_already_finished() {
     let fresh = CaseStore { dir: OutputDir::create(&dir, true, false).unwrap(), reuse: false };
     let third = bench::run(&one_null(), Some(&fresh), None, &|_, _| {}).unwrap();
     assert!(third.cases[0].seconds >= 0.0);
+    // The case's time is split into making its test and diagnosing it.
+    let c = &third.cases[0];
+    assert!(c.data_seconds > 0.0 && c.diagnosis_seconds > 0.0, "{} {}", c.data_seconds, c.diagnosis_seconds);
+    assert!(c.data_seconds + c.diagnosis_seconds <= c.seconds);
     assert_eq!(third.cases[0].truth, first.cases[0].truth);
     assert_eq!(third.cases[0].ranking, first.cases[0].ranking);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_prepared_case_is_the_test_the_benchmark_diagnoses() {
+    let plan = bench::Plan::new(&one_null()).unwrap();
+    let ran = plan.run_case(0);
+    let (made, prepared) = plan.prepare_case(0);
+    let prepared = prepared.unwrap();
+    assert_eq!((made.truth, made.readings), (ran.truth, ran.readings));
+    assert_eq!(made.diagnosis_seconds, 0.0, "preparing a case does not diagnose it");
+    let d = czid_problems::diagnose::run::diagnose_subject(
+        &prepared.subject,
+        &prepared.start,
+        plan.library(),
+        &prepared.options,
+    )
+    .unwrap();
+    let ranking: Vec<(String, f64, bool)> = d
+        .candidates
+        .iter()
+        .filter_map(|c| c.score.as_ref().map(|s| (c.name.clone(), s.statistic, s.significant)))
+        .collect();
+    assert_eq!(ranking, ran.ranking);
+    assert_eq!(d.outcome.cause.unwrap_or_else(|| bench::NONE.into()), ran.diagnosed);
 }
 
 #[test]

@@ -357,8 +357,11 @@ impl Solver<'_> {
         self.system.factor()?;
         let mut ra: Vec<f64> = (0..n).map(|i| if self.held[i] { 0.0 } else { -a.force[i] }).collect();
         let mut rb: Vec<f64> = col.iter().map(|v| -v).collect();
-        self.system.solve(&mut ra);
-        self.system.solve(&mut rb);
+        // Under displacement control the control's column plays no part (dδ = 0).
+        match control {
+            Control::Displacement(_) => self.system.solve(&mut ra),
+            Control::Opening { .. } => self.system.solve2(&mut ra, &mut rb),
+        }
         self.stats.factorisations += 1;
         self.stats.solver_seconds += t.elapsed().as_secs_f64();
         // Under displacement control the controlled unknowns already sit at their new value in
@@ -378,7 +381,10 @@ impl Solver<'_> {
                 (-constraint - dot(&ra)) / denom
             }
         };
-        let du = (0..n).map(|i| if self.held[i] { 0.0 } else { ra[i] + rb[i] * dd }).collect();
+        let du = match control {
+            Control::Displacement(_) => (0..n).map(|i| if self.held[i] { 0.0 } else { ra[i] }).collect(),
+            Control::Opening { .. } => (0..n).map(|i| if self.held[i] { 0.0 } else { ra[i] + rb[i] * dd }).collect(),
+        };
         Ok((du, dd))
     }
 

@@ -206,13 +206,34 @@ impl ContinuumProblem {
         let mut force = vec![0.0; n];
         let mut bulk_energy = 0.0;
         let mut new_bubbles = Vec::new();
+        // The cohesive points' gaps and laws, evaluated side by side (each on its own); their
+        // contributions are added below in the points' order, so the sums are the same whatever
+        // the threads.
+        let points = || -> Vec<_> {
+            self.cohesive
+                .par_iter()
+                .zip(committed)
+                .map(|(p, prev)| {
+                    let (g, terms) = p.gap(u);
+                    (g, terms, law.evaluate(&g, prev))
+                })
+                .collect()
+        };
+        let mut evaluated = None;
         match &elements.linear {
             Some(bulk) => {
-                bulk.mul_vec(u, &mut force);
+                // The arms' linear forces (and tangent copy) beside the interface's points.
+                let (_, e) = rayon::join(
+                    || {
+                        bulk.mul_vec(u, &mut force);
+                        if let Some(s) = system.as_deref_mut() {
+                            s.copy_from(bulk);
+                        }
+                    },
+                    points,
+                );
+                evaluated = Some(e);
                 bulk_energy = 0.5 * u.iter().zip(&force).map(|(a, b)| a * b).sum::<f64>();
-                if let Some(s) = system.as_deref_mut() {
-                    s.copy_from(bulk);
-                }
             }
             None => {
                 if let Some(s) = system.as_deref_mut() {
@@ -242,10 +263,14 @@ impl ContinuumProblem {
                 new_bubbles = responses.iter().map(|r| r.bubbles).collect();
             }
         }
-        let mut trial = InterfaceTrial::default();
-        for (p, prev) in self.cohesive.iter().zip(committed) {
-            let (g, terms) = p.gap(u);
-            let ev = law.evaluate(&g, prev);
+        let evaluated = evaluated.unwrap_or_else(points);
+        let m = evaluated.len();
+        let mut trial = InterfaceTrial {
+            gaps: Vec::with_capacity(m),
+            tractions: Vec::with_capacity(m),
+            states: Vec::with_capacity(m),
+        };
+        for (p, (g, terms, ev)) in self.cohesive.iter().zip(evaluated) {
             self.add_point(p, &terms, &ev.traction, &ev.tangent, &mut force, system.as_deref_mut());
             trial.gaps.push(g);
             trial.tractions.push(ev.traction);
@@ -277,8 +302,9 @@ impl ContinuumProblem {
             }
         }
         if let Some(s) = system {
-            for &(di, ci, cv) in terms {
-                for &(dj, cj, cw) in terms {
+            // A term of zero weight adds nothing (its products are zero and skipped).
+            for &(di, ci, cv) in terms.iter().filter(|t| t.2 != 0.0) {
+                for &(dj, cj, cw) in terms.iter().filter(|t| t.2 != 0.0) {
                     let v = w * cv * cw * tan[(ci, cj)];
                     if v != 0.0 {
                         s.add(di, dj, v);

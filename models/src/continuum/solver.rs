@@ -184,6 +184,18 @@ impl System {
         }
     }
 
+    /// Solves two right-hand sides with the factors, in place (the same results as two
+    /// [`System::solve`]s; the band's two substitutions interleaved).
+    pub fn solve2(&self, b1: &mut [f64], b2: &mut [f64]) {
+        match &self.store {
+            Store::Band(m) => m.solve2_in_place(b1, b2),
+            Store::Sparse(_) => {
+                self.solve(b1);
+                self.solve(b2);
+            }
+        }
+    }
+
     /// Solves with the factors, in place.
     pub fn solve(&self, b: &mut [f64]) {
         match &self.store {

@@ -133,8 +133,15 @@ pub struct CaseResult {
     pub pairs: Vec<(String, String, f64)>,
     /// Effect sizes drawn again because the planted model did not run to the end.
     pub redraws: usize,
-    /// Wall time (s).
+    /// Wall time (s): the synthetic test made, then diagnosed.
     pub seconds: f64,
+    /// Of which making the synthetic test (s): the planted model's run (a continuum run for
+    /// `--truth continuum`) and the noisy readings.
+    #[serde(default)]
+    pub data_seconds: f64,
+    /// Of which the diagnosis (s).
+    #[serde(default)]
+    pub diagnosis_seconds: f64,
     /// Why the case could not be diagnosed, if so.
     pub error: Option<String>,
 }
@@ -170,6 +177,7 @@ pub struct BenchReport {
 
 /// Runs one case: `planted` names the effect (`effect`, the candidate that plants it; `None` for a
 /// null case).
+#[allow(clippy::too_many_arguments)]
 fn case(
     index: usize,
     planted: &str,
@@ -178,6 +186,7 @@ fn case(
     family: Family,
     made_by: Truth,
     library: &Library,
+    mut keep: Option<&mut Option<PreparedCase>>,
 ) -> CaseResult {
     let clock = std::time::Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
@@ -222,9 +231,12 @@ fn case(
         pairs: Vec::new(),
         redraws: 0,
         seconds: 0.0,
+        data_seconds: 0.0,
+        diagnosis_seconds: 0.0,
         error: None,
     };
     let mut run = || -> Result<()> {
+        let made = std::time::Instant::now();
         let base = family.base_setup(&draw)?;
         let record = planted_record(&base, effect, (family, made_by), &mut size, &mut rng, &mut out)?;
         // Without a set end the test is read up to a share of the deflection at its peak load.
@@ -261,8 +273,15 @@ fn case(
             model_form: made_by != Truth::Beam,
             ..Options::default()
         };
-        let d = diagnose_subject(&subject, &u0, library, &opts)?;
-        record_diagnosis(&mut out, &d, planted);
+        out.data_seconds = made.elapsed().as_secs_f64();
+        if let Some(k) = keep.as_deref_mut() {
+            *k = Some(PreparedCase { subject, start: u0, options: opts });
+            return Ok(());
+        }
+        let diagnosing = std::time::Instant::now();
+        let d = diagnose_subject(&subject, &u0, library, &opts);
+        out.diagnosis_seconds = diagnosing.elapsed().as_secs_f64();
+        record_diagnosis(&mut out, &d?, planted);
         Ok(())
     };
     if let Err(e) = run() {
@@ -270,6 +289,16 @@ fn case(
     }
     out.seconds = clock.elapsed().as_secs_f64();
     out
+}
+
+/// A case's synthetic test, made and ready to diagnose as the benchmark does.
+pub struct PreparedCase {
+    /// The base model, fitted parameters and synthetic data.
+    pub subject: Subject,
+    /// Where the diagnosis starts (unit cube: the true values jittered).
+    pub start: Vec<f64>,
+    /// The benchmark's diagnosis options.
+    pub options: Options,
 }
 
 /// The planted model's record; a planted model that stops early is drawn again (a few times),
@@ -460,7 +489,25 @@ impl Plan {
     pub fn run_case(&self, i: usize) -> CaseResult {
         let p = &self.cases[i];
         let effect = self.candidates.iter().find(|c| c.name() == p).map(|c| c.as_ref());
-        case(i, p, effect, self.opts.seed, self.opts.family, self.opts.truth, &self.library)
+        case(i, p, effect, self.opts.seed, self.opts.family, self.opts.truth, &self.library, None)
+    }
+
+    /// Makes case `i`'s synthetic test without diagnosing it (e.g. to diagnose it alone, or
+    /// write it out), with what the case records of its making.
+    pub fn prepare_case(&self, i: usize) -> (CaseResult, Result<PreparedCase>) {
+        let p = &self.cases[i];
+        let effect = self.candidates.iter().find(|c| c.name() == p).map(|c| c.as_ref());
+        let mut kept = None;
+        let out = case(i, p, effect, self.opts.seed, self.opts.family, self.opts.truth, &self.library, Some(&mut kept));
+        let prepared = kept.ok_or_else(|| {
+            CzError::Simulation(out.error.clone().unwrap_or_else(|| "the case's test could not be made".into()))
+        });
+        (out, prepared)
+    }
+
+    /// The library the cases are diagnosed with.
+    pub fn library(&self) -> &Library {
+        &self.library
     }
 
     /// Runs case `i` and gives its result as JSON (what a [`TaskFarm`] moves).
@@ -705,14 +752,35 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
     }
     let provisional = r.cases.iter().filter(|c| c.provisional).count();
     let _ = writeln!(s, "Provisional verdicts: {provisional} of {}.", r.cases.len());
-    let mut times: Vec<f64> = r.cases.iter().map(|c| c.seconds).collect();
-    times.sort_by(f64::total_cmp);
-    if let (Some(max), false) = (times.last(), times.is_empty()) {
+    let spread = |f: &dyn Fn(&CaseResult) -> f64| -> Option<(f64, f64)> {
+        let mut t: Vec<f64> = r.cases.iter().map(f).filter(|t| t.is_finite() && *t > 0.0).collect();
+        t.sort_by(f64::total_cmp);
+        t.last().map(|max| (t[t.len() / 2], *max))
+    };
+    if let Some((median, max)) = spread(&|c| c.seconds) {
         let _ = writeln!(
             s,
-            "Case times (synthetic test + diagnosis, cases run side by side): median {:.1} s, maximum {:.1} s.",
-            times[times.len() / 2],
-            max
+            "Case times (synthetic test + diagnosis, cases run side by side): median {median:.1} s, maximum {max:.1} s."
+        );
+    }
+    for (what, f) in [
+        ("making the synthetic test", &(|c: &CaseResult| c.data_seconds) as &dyn Fn(&CaseResult) -> f64),
+        ("the diagnosis alone", &|c: &CaseResult| c.diagnosis_seconds),
+    ] {
+        if let Some((median, max)) = spread(f) {
+            let _ = writeln!(s, "Of which {what}: median {median:.1} s, maximum {max:.1} s.");
+        }
+    }
+    let slowest = r
+        .cases
+        .iter()
+        .filter(|c| c.diagnosis_seconds > 0.0)
+        .max_by(|a, b| a.diagnosis_seconds.total_cmp(&b.diagnosis_seconds));
+    if let Some(c) = slowest {
+        let _ = writeln!(
+            s,
+            "Slowest diagnosis: case {} ({}, {}), {:.1} s.",
+            c.index, c.planted, c.specimen, c.diagnosis_seconds
         );
     }
     let _ = writeln!(

@@ -58,7 +58,10 @@ impl Misfit {
     /// The misfit of `setup` on `gauge`: its experiments simulated through the path every
     /// identification uses ([`simulate_experiments`]), compared reading by reading.
     pub fn of(gauge: &Gauge, setup: &Setup) -> Result<Misfit> {
-        let Runs { records, failures, .. } = simulate_experiments(setup, &gauge.experiments())?;
+        let clock = std::time::Instant::now();
+        let runs = simulate_experiments(setup, &gauge.experiments());
+        tally::count(setup, clock.elapsed());
+        let Runs { records, failures, .. } = runs?;
         Ok(Misfit { r: gauge.residuals(&records)?, records, failures })
     }
 
@@ -197,5 +200,31 @@ impl Gauge {
                 r
             })
             .collect()
+    }
+}
+
+/// A count of the misfits evaluated in this process, by the models run (what a diagnosis's
+/// stages cost, in forward runs and their summed time).
+pub mod tally {
+    use crate::identification::Setup;
+    use std::collections::BTreeMap;
+    use std::sync::Mutex;
+    use std::time::Duration;
+
+    static RUNS: Mutex<BTreeMap<String, (usize, Duration)>> = Mutex::new(BTreeMap::new());
+
+    pub(super) fn count(setup: &Setup, spent: Duration) {
+        let key: Vec<&str> = setup.models.values().map(|m| m.name()).collect();
+        if let Ok(mut runs) = RUNS.lock() {
+            let e = runs.entry(key.join("+")).or_default();
+            e.0 += 1;
+            e.1 += spent;
+        }
+    }
+
+    /// Misfits evaluated so far, and the time spent in them (summed over threads), by the models
+    /// run.
+    pub fn snapshot() -> BTreeMap<String, (usize, Duration)> {
+        RUNS.lock().map(|r| r.clone()).unwrap_or_default()
     }
 }
