@@ -12,8 +12,16 @@ use std::time::Instant;
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let (seed, index): (u64, usize) = (a[1].parse().unwrap(), a[2].parse().unwrap());
-    let (strength, g): (f64, f64) = (a[3].parse().unwrap(), a[4].parse().unwrap());
+    let usage = "usage: reference_run SEED INDEX STRENGTH G_IC [DUMP_FILE] (integers SEED, INDEX; \
+                 the law's strength in MPa and G_Ic in N/mm)";
+    let number = |i: usize| -> f64 {
+        a.get(i).and_then(|v| v.parse().ok()).unwrap_or_else(|| {
+            eprintln!("{usage}");
+            std::process::exit(2)
+        })
+    };
+    let (seed, index) = (number(1) as u64, number(2) as usize);
+    let (strength, g) = (number(3), number(4));
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(index as u64));
     let draw = Family::Dcb.draw(index, &mut rng);
     let setup = Family::Dcb.base_setup(&draw).unwrap();

@@ -53,6 +53,12 @@ pub enum Term {
     Event,
 }
 
+/// The objective term's name of event `event` of experiment `experiment`, e.g.
+/// `E:beam:debonded_length_at_onset`.
+pub fn event_term_name(experiment: &str, event: &str) -> String {
+    format!("{}:{experiment}:{event}", Term::Event.symbol())
+}
+
 /// A term's root-mean-square error at the identified parameters ([`Identification::term_errors`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RmsError {
@@ -284,7 +290,7 @@ impl Identification {
             for ev in &e.events {
                 // One reading; its abscissa is not used by an event response.
                 terms.push(ObjectiveTerm {
-                    name: format!("E:{}:{}", e.name, ev.name),
+                    name: event_term_name(&e.name, &ev.name),
                     response: ev.response.boxed(),
                     data: Curve::new(vec![0.0], vec![ev.value])?,
                     weight: ev.weight,

@@ -3,7 +3,7 @@
 
 use crate::event::MISSED_EVENT_FACTOR;
 use crate::identifiability::{assess, Verdict};
-use crate::identification::{Identification, Outcome, RmsError};
+use crate::identification::{event_term_name, Identification, Outcome, RmsError};
 use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
 use crate::problem_file::LoadedProblem;
@@ -453,7 +453,7 @@ pub fn missed_events(problem: &LoadedProblem, errors: &[(String, RmsError)]) -> 
     for e in &problem.experiments {
         for ev in &e.events {
             let Some(u) = ev.uncertainty else { continue };
-            let term = format!("E:{}:{}", e.name, ev.name);
+            let term = event_term_name(&e.name, &ev.name);
             let Some((_, err)) = errors.iter().find(|(name, _)| *name == term) else { continue };
             if err.value > MISSED_EVENT_FACTOR * u {
                 let unit = ev.unit();
