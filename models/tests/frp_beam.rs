@@ -140,6 +140,13 @@ fn a_run_stopped_at_a_deflection_is_the_full_run_up_to_its_first_crossing() {
         let (a, b) = (stopped.record.column(name).unwrap(), full.record.column(name).unwrap());
         assert_eq!(a, &b[..=first], "{name}");
     }
+    // The deflection compared is the recorded one, with a measurement offset if one is planted.
+    beam.effects.deflection_offset = 1.5;
+    let offset = beam.run(&law, false).unwrap();
+    let d = offset.record.column(columns::DISPLACEMENT).unwrap();
+    let n = d.len();
+    assert!(d[n - 1] >= 24.0 && d[n - 2] < 24.0, "{} {}", d[n - 2], d[n - 1]);
+    assert!(n < stopped.record.rows(), "the offset reaches 24 mm earlier");
     beam.control.max_deflection = Some(-1.0);
     let err = beam.validate().unwrap_err().to_string();
     assert!(err.contains("control.max_deflection"), "{err}");

@@ -156,7 +156,7 @@ pub struct BeamControl {
     /// tolerance (a step of that size is taken whatever the difference: an unstable stretch of the
     /// path, crossed at nearly fixed elongation).
     pub min_step_fraction: f64,
-    /// Mid-span deflection (mm) at which the run ends, if it has not ended before: the state
+    /// Mid-span deflection (mm, as recorded) at which the run ends, if it has not ended before: the state
     /// recorded where the deflection first reaches it is the last. A test that stopped at a
     /// known deflection need not be followed beyond it (the states after the first crossing are
     /// never compared with the test; the event "debonded length at the end of the test" reads
@@ -619,7 +619,8 @@ impl FrpBeam {
                     debonded_before = true;
                 }
             }
-            if c.max_deflection.is_some_and(|d| w(0) >= d) {
+            // The deflection as recorded (with a measurement offset, if one is planted).
+            if c.max_deflection.is_some_and(|d| w(0) + self.effects.deflection_offset >= d) {
                 end = RunEnd::MaxDeflection;
                 return true;
             }
