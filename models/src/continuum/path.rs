@@ -201,9 +201,14 @@ pub fn run(p: &ContinuumProblem, law: &dyn CohesiveLaw, settings: &PathSettings)
             });
             match result {
                 Ok(next) => {
+                    // Grow the step while it converges, but keep the recorded rows about one
+                    // output spacing apart in the applied displacement: the record is read
+                    // between its rows.
+                    let moved = (next.delta - state.delta).abs();
+                    let growth = if moved > 0.0 { (grid / moved).clamp(0.25, 1.5) } else { 1.5 };
                     state = next;
                     rows.push(s.row(&state));
-                    opening_step = (opening_step * 1.5).min(settings.max_opening_step);
+                    opening_step = (opening_step * growth).min(settings.max_opening_step);
                 }
                 Err(why) => {
                     opening_step *= 0.25;
@@ -263,7 +268,9 @@ impl Solver<'_> {
     ///
     /// Newton with a backtracking line search on the residual: where a cohesive point sits on the
     /// kink of its law (the peak, the onset of damage), plain Newton can cycle between loading and
-    /// unloading it; halving the update until the residual falls breaks the cycle.
+    /// unloading it; halving the update until the residual falls breaks the cycle. Where no
+    /// halving lowers it (points crossing their kinks), the full update is taken: short ones
+    /// left the crack-front points where they were, 10–19 iterations a step instead of about 6.
     fn step(&mut self, st: &State, control: Control) -> Result<State, String> {
         let n = self.p.unknowns();
         let mut u = st.u.clone();
@@ -296,20 +303,31 @@ impl Solver<'_> {
             let weight = scale / self.settings.max_opening_step;
             let merit = |e: &Evaluation| e.norm + e.constraint.abs() * weight;
             let start = norm + constraint.abs() * weight;
-            let mut alpha = 1.0;
-            current = loop {
+            let step = |alpha: f64| -> (Vec<f64>, f64) {
                 let mut trial = u.clone();
                 for i in 0..n {
                     trial[i] += alpha * du[i];
                 }
-                let td = delta + alpha * dd;
+                (trial, delta + alpha * dd)
+            };
+            let mut alpha = 1.0;
+            current = loop {
+                let (mut trial, td) = step(alpha);
                 // The full update usually stands: assemble its tangent with its residual.
                 let full = alpha == 1.0;
                 let e = self.evaluate(&mut trial, td, st, &control, full);
-                if merit(&e) < start || alpha < 0.1 || iteration == 0 {
+                if merit(&e) < start || iteration == 0 {
                     u = trial;
                     delta = td;
                     break if full { e } else { self.evaluate(&mut u, delta, st, &control, true) };
+                }
+                if alpha < 0.1 {
+                    // No shorter update lowers the residual: the points crossing a kink of their
+                    // law (onset, unloading) make it a poor guide there. A short update would keep
+                    // them where they are for many iterations; the full one moves them to the
+                    // side of the kink their law puts them on, and Newton converges from there.
+                    (u, delta) = step(1.0);
+                    break self.evaluate(&mut u, delta, st, &control, true);
                 }
                 alpha *= 0.5;
             };
