@@ -311,6 +311,9 @@ impl Solver<'_> {
                 (trial, delta + alpha * dd)
             };
             let mut alpha = 1.0;
+            // The full update's state and evaluation, kept while shorter ones are tried (their
+            // evaluations leave the system holding the full update's tangent).
+            let mut full_update = None;
             current = loop {
                 let (mut trial, td) = step(alpha);
                 // The full update usually stands: assemble its tangent with its residual.
@@ -321,13 +324,20 @@ impl Solver<'_> {
                     delta = td;
                     break if full { e } else { self.evaluate(&mut u, delta, st, &control, true) };
                 }
-                if alpha < 0.1 {
+                if full {
+                    full_update = Some((trial, td, e));
+                } else if alpha < 0.1 {
                     // No shorter update lowers the residual: the points crossing a kink of their
                     // law (onset, unloading) make it a poor guide there. A short update would keep
                     // them where they are for many iterations; the full one moves them to the
                     // side of the kink their law puts them on, and Newton converges from there.
-                    (u, delta) = step(1.0);
-                    break self.evaluate(&mut u, delta, st, &control, true);
+                    let Some((t, d, e)) = full_update.take() else {
+                        // Unreachable (the full update is tried first), but never a loop.
+                        (u, delta) = (trial, td);
+                        break self.evaluate(&mut u, delta, st, &control, true);
+                    };
+                    (u, delta) = (t, d);
+                    break e;
                 }
                 alpha *= 0.5;
             };
