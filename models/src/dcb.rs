@@ -376,6 +376,7 @@ impl ForwardModel for Dcb {
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
         let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
         law.validate().map_err(fail)?;
+        self.effects.check_root_compliance("dcb", law).map_err(fail)?;
         let (p, scale) = self.problem().map_err(fail)?;
         let path = self.path(law, &scale);
         match beamtest::run(&p, law, &path, &RUN, &scale) {
@@ -389,6 +390,7 @@ impl ForwardModel for Dcb {
 /// Runs `dcb` and also returns the engine's statistics (steps, iterations, factorisations).
 pub fn simulate_with_stats(dcb: &Dcb, law: &dyn CohesiveLaw) -> Result<(Record, fe::RunStats)> {
     law.validate()?;
+    dcb.effects.check_root_compliance("dcb", law)?;
     let (p, scale) = dcb.problem()?;
     let path = dcb.path(law, &scale);
     beamtest::run(&p, law, &path, &RUN, &scale).map_err(|f| f.error)

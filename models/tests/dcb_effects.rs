@@ -133,6 +133,26 @@ fn root_compliance_is_kanninens_foundation_in_series_with_the_interface() {
 }
 
 #[test]
+fn a_root_compliance_that_would_leave_a_nearly_brittle_interface_is_refused_at_once_with_its_limit() {
+    // Closed form: a bilinear law softens with slope σ / (δf − δ0), δf = 2 G / σ, δ0 = σ / K.
+    let (k, sigma, g) = (1e5, 27.0, 0.744);
+    let law = TestBilinear::new(k, sigma, g);
+    let slope = sigma / (2.0 * g / sigma - sigma / k);
+    let measured = czid_models::effects::steepest_mode_one_softening(&law);
+    assert!((measured / slope - 1.0).abs() < 1e-6, "{measured} vs {slope}");
+    let limit = czid_models::effects::ROOT_COMPLIANCE_SHARE / (2.0 * slope);
+    let mut d = Dcb::paper();
+    d.effects.root_compliance = 1.05 * limit;
+    let error = d.simulate(&law).unwrap_err().error.to_string();
+    assert!(error.contains("effects.root_compliance") && error.contains(&format!("{limit:.4e}")), "{error}");
+    // Well inside the limit the crack runs on the window, as without the springs.
+    d.effects.root_compliance = 0.6 / (2.0 * slope);
+    let (record, stats) = czid_models::dcb::simulate_with_stats(&d, &law).unwrap();
+    assert!(stats.windowed, "{stats:?}");
+    assert!(record.rows() > 50);
+}
+
+#[test]
 fn large_rotations_agree_with_small_ones_at_small_openings() {
     let mut d = base();
     d.control.max_displacement = Some(1.0);
