@@ -76,4 +76,12 @@ pub trait ForwardModel: Send + Sync + std::fmt::Debug {
     fn reference(&self) -> Option<Box<dyn ForwardModel>> {
         None
     }
+
+    /// The same model on a coarser discretisation (default: none). The diagnosis runs a
+    /// [`ForwardModel::reference`] and, where it has one, its coarsened twin at the fitted law:
+    /// the difference of the two is how far the reference itself may sit from a converged
+    /// solution, the uncertainty of the model-form floor it estimates.
+    fn coarsened(&self) -> Option<Box<dyn ForwardModel>> {
+        None
+    }
 }

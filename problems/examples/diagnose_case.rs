@@ -54,7 +54,10 @@ fn main() {
     let seconds = diagnosing.elapsed().as_secs_f64();
     println!("diagnosis: {seconds:.1} s");
     print_tally("diagnosis total", &tally::snapshot(), &before);
-    println!("base: chi2/dof {:.4}, evaluations {}", d.base.reduced_chi2, d.base.evaluations);
+    println!(
+        "base: chi2/dof {:.4}, structure p {:.3e}, model-form shift {:.3} (floor uncertainty {:.3}) noise units, evaluations {}",
+        d.base.reduced_chi2, d.base.structure_p, d.model_form.shift_rms, d.model_form.floor_rms, d.base.evaluations
+    );
     for c in &d.candidates {
         if let Some(r) = &c.refit {
             println!(

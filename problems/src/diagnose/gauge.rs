@@ -25,6 +25,11 @@ pub struct Block {
     pub sigma: f64,
     /// Whether σ was estimated from the data (false: given by the user).
     pub sigma_estimated: bool,
+    /// Per reading, how far (N or mm) the model-form floor itself may be off
+    /// ([`crate::diagnose::stages::model_form`]); empty: no estimate. An error of the floor is
+    /// smooth along the curve, so [`Gauge::structure_p`] counts it once per bin, not per reading.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub floor: Vec<f64>,
 }
 
 /// Noise levels given instead of estimated.
@@ -92,6 +97,7 @@ impl Gauge {
                 y,
                 sigma,
                 sigma_estimated: noise_levels.load.is_none(),
+                floor: Vec::new(),
             });
             if let (true, Some(l)) = (use_length, &e.debonded_length) {
                 if l.norm() > 0.0 {
@@ -104,6 +110,7 @@ impl Gauge {
                         y,
                         sigma,
                         sigma_estimated: noise_levels.length.is_none(),
+                        floor: Vec::new(),
                     });
                 }
             }
@@ -142,6 +149,7 @@ impl Gauge {
                 (!idx.is_empty()).then(|| Block {
                     x: idx.iter().map(|&i| b.x[i]).collect(),
                     y: idx.iter().map(|&i| b.y[i]).collect(),
+                    floor: if b.floor.is_empty() { Vec::new() } else { idx.iter().map(|&i| b.floor[i]).collect() },
                     ..b.clone()
                 })
             })
@@ -187,6 +195,24 @@ impl Gauge {
             r.extend(scaled_residuals(&Self::curve(b)?, record, &b.x, &b.y, b.sigma)?);
         }
         Ok(r)
+    }
+
+    /// Probability that residuals `r` (noise units) show at least the structure they show, with
+    /// the floor's uncertainty of every block allowed for
+    /// ([`crate::diagnose::stats::structure_p_with_floor`]).
+    pub fn structure_p(&self, r: &[f64]) -> f64 {
+        let floor: Vec<f64> = if self.blocks.iter().all(|b| b.floor.is_empty()) {
+            Vec::new()
+        } else {
+            self.blocks
+                .iter()
+                .flat_map(|b| {
+                    let f = |i: usize| b.floor.get(i).map_or(0.0, |f| f / b.sigma);
+                    (0..b.x.len()).map(f)
+                })
+                .collect()
+        };
+        crate::diagnose::stats::structure_p_with_floor(r, &self.ranges(), &floor)
     }
 
     /// Index ranges of the blocks in the residual vector.

@@ -426,7 +426,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         reduced_chi2: base.chi2 / base.dof as f64,
         p_value: base.p_noise,
         at_noise_level: base.p_noise > NOISE_LEVEL,
-        structure_p: crate::diagnose::stats::structure_p(&base.misfit.r, &base.gauge.ranges()),
+        structure_p: base.gauge.structure_p(&base.misfit.r),
         model_form_accounted: model_form.applied(),
         evaluations: base.evaluations,
         failures: base.misfit.failures.clone(),
@@ -499,10 +499,10 @@ fn reestimated(
     let p = base.space.dim();
     let fitted = base.space.apply(&base.setup, &base.space.from_unit(&out.v[..p]))?;
     let Some(gauge) = model_form::account_at(measured, &fitted)? else { return Ok(None) };
-    let ranges = gauge.ranges();
+    let gauge = model_form::with_floor_of(gauge, &base.gauge);
     Ok(refit::refit_on(&gauge, base, c, params, &out.v, out.jacobian.clone())
         .ok()
-        .map(|o| (o.misfit.rss(), crate::diagnose::stats::structure_p(&o.misfit.r, &ranges))))
+        .map(|o| (o.misfit.rss(), gauge.structure_p(&o.misfit.r))))
 }
 
 /// A refitted candidate: the effect, its parameters and the refit.

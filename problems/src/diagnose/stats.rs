@@ -13,14 +13,25 @@ pub const STRUCTURE_BIN: usize = 10;
 /// χ² of all readings cannot tell from noise) is plain here: binning keeps the misfit and divides
 /// the noise's share by the bin length. A tail bin shorter than half a bin is left out.
 pub fn structure_p(r: &[f64], ranges: &[std::ops::Range<usize>]) -> f64 {
+    structure_p_with_floor(r, ranges, &[])
+}
+
+/// [`structure_p`] with a smooth error of known size on top of the noise: `floor` (noise units,
+/// per reading; empty: none) is how far the model-form floor may be off at each reading. Such an
+/// error moves all readings of a bin together, so a bin's sum has the variance `L + F²` (`L`
+/// readings of white noise, `F` the sum of the bin's floor), not `L (1 + f²)`: a misfit that
+/// stays within the floor's uncertainty is not taken for structure, one well beyond it still is.
+pub fn structure_p_with_floor(r: &[f64], ranges: &[std::ops::Range<usize>], floor: &[f64]) -> f64 {
     let (mut stat, mut bins) = (0.0, 0usize);
     for range in ranges {
-        for bin in r[range.clone()].chunks(STRUCTURE_BIN) {
+        for (k, bin) in r[range.clone()].chunks(STRUCTURE_BIN).enumerate() {
             if 2 * bin.len() < STRUCTURE_BIN {
                 continue;
             }
+            let start = range.start + k * STRUCTURE_BIN;
+            let f: f64 = floor.get(start..start + bin.len()).map_or(0.0, |f| f.iter().sum());
             let sum: f64 = bin.iter().sum();
-            stat += sum * sum / bin.len() as f64;
+            stat += sum * sum / (bin.len() as f64 + f * f);
             bins += 1;
         }
     }
@@ -149,6 +160,30 @@ mod tests {
             by_bins += usize::from(structure_p(&r, &[0..n]) <= 1e-3);
         }
         assert!(by_chi2 <= 8 && by_bins >= 19, "flagged by χ² {by_chi2}/20, by the bins {by_bins}/20");
+    }
+
+    #[test]
+    fn a_smooth_misfit_within_the_floor_uncertainty_is_not_structure_and_one_well_beyond_it_is() {
+        let n = 450;
+        let smooth = |i: usize, a: f64| a * (i as f64 / 90.0).sin();
+        let (mut within, mut beyond, mut none) = (0, 0, 0);
+        for seed in 0..20 {
+            let e = white(n, 2000 + seed);
+            // A model-form error of 0.6 noise units whose size the floor states (0.6 per reading).
+            let r: Vec<f64> = e.iter().enumerate().map(|(i, v)| v + smooth(i, 0.6)).collect();
+            within += usize::from(structure_p_with_floor(&r, &[0..n], &vec![0.6; n]) <= 1e-3);
+            none += usize::from(structure_p(&r, &[0..n]) <= 1e-3);
+            // An effect rising to 3 noise units (five times the floor's uncertainty) on top of it.
+            let big: Vec<f64> =
+                e.iter().enumerate().map(|(i, v)| v + smooth(i, 0.6) + 3.0 * (i as f64 / n as f64)).collect();
+            beyond += usize::from(structure_p_with_floor(&big, &[0..n], &vec![0.6; n]) <= 1e-3);
+        }
+        assert!(none >= 19, "without the floor the model-form error is structure in {none}/20");
+        assert!(within <= 1, "within the floor's uncertainty flagged in {within}/20");
+        assert!(beyond >= 19, "beyond the floor's uncertainty flagged in only {beyond}/20");
+        // No floor is the plain test.
+        let e = white(n, 7);
+        assert_eq!(structure_p_with_floor(&e, &[0..n], &[]), structure_p(&e, &[0..n]));
     }
 
     #[test]

@@ -38,6 +38,10 @@ pub struct ModelForm {
     pub shift_rms: f64,
     /// Largest shift (noise units).
     pub shift_max: f64,
+    /// RMS of the floor's own uncertainty (noise units): the shift computed again with each
+    /// reference model's coarsened twin ([`czid_core::ForwardModel::coarsened`]), minus the shift,
+    /// smoothed. 0 when a reference has no coarsened twin (the floor is then taken as exact).
+    pub floor_rms: f64,
     /// Why the floor was not estimated, when it was not.
     pub note: Option<String>,
 }
@@ -51,6 +55,7 @@ impl ModelForm {
             chi2_accounted: chi2,
             shift_rms: 0.0,
             shift_max: 0.0,
+            floor_rms: 0.0,
             note: Some(note),
         }
     }
@@ -72,6 +77,31 @@ fn reference_setup(fitted: &Setup) -> std::result::Result<(Setup, BTreeMap<Strin
     }
     let law = fitted.duplicate().map_err(|e| e.to_string())?.law;
     Ok((Setup { law, models }, names))
+}
+
+/// `reference` with every model replaced by its coarsened twin; `None` when one has none.
+fn coarsened_setup(reference: &Setup) -> Option<Setup> {
+    let models = reference.models.iter().map(|(n, m)| Some((n.clone(), m.coarsened()?))).collect::<Option<_>>()?;
+    let law = reference.duplicate().ok()?.law;
+    Some(Setup { law, models })
+}
+
+/// Per block and reading, the uncertainty of the model-form shift `raw` (noise units, unsmoothed
+/// `(base − reference)/σ`): `|smooth(raw − raw_coarse)|`, the change the reference's
+/// coarsened twin makes; `None` when there is no twin or its run stopped early (the floor is then
+/// taken as exact, as before this estimate existed).
+fn floor_uncertainty(gauge: &Gauge, reference: &Setup, raw: &[f64], r: &[f64]) -> Result<Option<Vec<f64>>> {
+    let Some(coarse) = coarsened_setup(reference) else { return Ok(None) };
+    let misfit = Misfit::of(gauge, &coarse)?;
+    if !misfit.failures.is_empty() {
+        return Ok(None);
+    }
+    let mut out = Vec::with_capacity(gauge.len());
+    for (b, range) in gauge.blocks.iter().zip(gauge.ranges()) {
+        let d: Vec<f64> = range.map(|i| (misfit.r[i] - r[i]) - raw[i]).collect();
+        out.extend(smooth(&b.x, &d).into_iter().map(f64::abs));
+    }
+    Ok(Some(out))
 }
 
 /// Local straight-line fit of `v` over `x`, `HALF_WINDOW` readings on either side.
@@ -102,16 +132,25 @@ pub fn account(base: &Base) -> Result<(Option<Gauge>, ModelForm)> {
         Ok(s) => s,
         Err(note) => return Ok((None, ModelForm::not_estimated(base.chi2, note))),
     };
-    let n = shifted.1.len().max(1) as f64;
+    let (mut gauge, shift, raw) = shifted;
+    let n = shift.len().max(1) as f64;
+    let mut floor_rms = 0.0;
+    if let Some(floor) = floor_uncertainty(&base.gauge, &setup, &raw, &base.misfit.r)? {
+        floor_rms = (floor.iter().map(|f| f * f).sum::<f64>() / n).sqrt();
+        for (b, range) in gauge.blocks.iter_mut().zip(base.gauge.ranges()) {
+            b.floor = floor[range].iter().map(|f| f * b.sigma).collect();
+        }
+    }
     let form = ModelForm {
         reference,
         chi2_as_measured: base.chi2,
         chi2_accounted: f64::NAN,
-        shift_rms: (shifted.1.iter().map(|s| s * s).sum::<f64>() / n).sqrt(),
-        shift_max: shifted.1.iter().fold(0.0, |m, s| m.max(s.abs())),
+        shift_rms: (shift.iter().map(|s| s * s).sum::<f64>() / n).sqrt(),
+        shift_max: shift.iter().fold(0.0, |m, s| m.max(s.abs())),
+        floor_rms,
         note: None,
     };
-    Ok((Some(shifted.0), form))
+    Ok((Some(gauge), form))
 }
 
 /// The measured gauge shifted by the model-form misfit of `fitted` (the base model with other
@@ -126,15 +165,29 @@ pub fn account_at(measured: &Gauge, fitted: &Setup) -> Result<Option<Gauge>> {
     Ok(shift(measured, &beam.r, &setup)?.ok().map(|s| s.0))
 }
 
+/// `gauge` with the floor uncertainty of `from` (the same blocks, e.g. the base fit's gauge).
+pub fn with_floor_of(mut gauge: Gauge, from: &Gauge) -> Gauge {
+    for (b, f) in gauge.blocks.iter_mut().zip(&from.blocks) {
+        if b.x.len() == f.floor.len() {
+            b.floor.clone_from(&f.floor);
+        }
+    }
+    gauge
+}
+
+/// A shifted gauge, the smoothed shift and the raw one (noise units).
+type Shifted = (Gauge, Vec<f64>, Vec<f64>);
+
 /// `gauge` with its data shifted by the smoothed difference between the residuals `r` of the
-/// base model and those of the `reference` setup, and that shift (noise units); or why not.
-fn shift(gauge: &Gauge, r: &[f64], reference: &Setup) -> Result<std::result::Result<(Gauge, Vec<f64>), String>> {
+/// base model and those of the `reference` setup, and that shift (noise units, smoothed and raw);
+/// or why not.
+fn shift(gauge: &Gauge, r: &[f64], reference: &Setup) -> Result<std::result::Result<Shifted, String>> {
     let misfit = Misfit::of(gauge, reference)?;
     if !misfit.failures.is_empty() {
         return Ok(Err(format!("the reference model stopped early: {}", misfit.failures.join("; "))));
     }
     let mut shifted = gauge.clone();
-    let mut all = Vec::with_capacity(gauge.len());
+    let (mut all, mut all_raw) = (Vec::with_capacity(gauge.len()), Vec::with_capacity(gauge.len()));
     for (b, range) in shifted.blocks.iter_mut().zip(gauge.ranges()) {
         // (test − reference)/σ − (test − base)/σ = (base − reference)/σ.
         let raw: Vec<f64> = range.map(|i| misfit.r[i] - r[i]).collect();
@@ -143,8 +196,9 @@ fn shift(gauge: &Gauge, r: &[f64], reference: &Setup) -> Result<std::result::Res
             *y += b.sigma * v;
         }
         all.extend(s);
+        all_raw.extend(raw);
     }
-    Ok(Ok((shifted, all)))
+    Ok(Ok((shifted, all, all_raw)))
 }
 
 #[cfg(test)]

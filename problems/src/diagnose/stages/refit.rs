@@ -229,6 +229,6 @@ pub fn report(base: &Base, regs: &[Regime], entry: &Ranked, out: &RefitOutcome) 
         delta_bic: bic - base_bic,
         evaluations: out.evaluations,
         chi2_reestimated: None,
-        structure_p: crate::diagnose::stats::structure_p(&out.misfit.r, &base.gauge.ranges()),
+        structure_p: base.gauge.structure_p(&out.misfit.r),
     }
 }

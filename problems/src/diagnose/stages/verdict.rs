@@ -234,9 +234,16 @@ pub fn text(
     }
     if form.applied() {
         out.push_str(&format!(
-            " (The model-form misfit, estimated with the reference model, was accounted for: χ² {:.0} as measured, {:.0} after.)",
+            " (The model-form misfit, estimated with the reference model, was accounted for: χ² {:.0} as measured, {:.0} after",
             form.chi2_as_measured, form.chi2_accounted
         ));
+        if form.floor_rms > 0.0 {
+            out.push_str(&format!(
+                "; the reference's own discretisation leaves it uncertain by {:.2} noise units RMS, which the structure test allows for",
+                form.floor_rms
+            ));
+        }
+        out.push_str(".)");
     }
     if outcome.provisional {
         out.push_str(&format!(" Provisional: {}.", outcome.reasons.join("; ")));
@@ -470,6 +477,7 @@ mod tests {
             chi2_accounted: 0.0,
             shift_rms: 0.0,
             shift_max: 0.0,
+            floor_rms: 0.0,
             note: Some("not estimated".into()),
         };
         let words = text(&structured, &form, &[], &weak, &o);
