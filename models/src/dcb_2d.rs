@@ -296,15 +296,10 @@ impl ForwardModel for Dcb2d {
         Ok(Vec::new())
     }
 
-    /// One element fewer through each arm (at least two): the through-thickness discretisation
-    /// is what keeps a 4-element arm from the converged bending and shear near the crack front;
-    /// the interface elements stay (they must resolve the cohesive zone).
+    /// One element fewer through each arm ([`ContinuumMesh::coarsened`]).
     fn coarsened(&self) -> Option<Box<dyn ForwardModel>> {
-        (self.mesh.thickness_elements > 2).then(|| {
-            let mut m = self.clone();
-            m.mesh.thickness_elements -= 1;
-            Box::new(m) as Box<dyn ForwardModel>
-        })
+        let mesh = self.mesh.coarsened()?;
+        Some(Box::new(Dcb2d { mesh, ..self.clone() }))
     }
 
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {

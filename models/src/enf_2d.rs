@@ -271,6 +271,12 @@ impl ForwardModel for Enf2d {
         ContinuumEffects::declarations(false)
     }
 
+    /// One element fewer through each arm ([`ContinuumMesh::coarsened`]).
+    fn coarsened(&self) -> Option<Box<dyn ForwardModel>> {
+        let mesh = self.mesh.coarsened()?;
+        Some(Box::new(Enf2d { mesh, ..self.clone() }))
+    }
+
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
         self.simulate_with_stats(law).map(|(r, _)| r)
     }

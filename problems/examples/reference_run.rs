@@ -1,5 +1,6 @@
 //! Times the reference (continuum) run of a `gap-bench` DCB case's base model at given law
-//! values: `reference_run SEED INDEX STRENGTH G_IC [DUMP_FILE]`.
+//! values: `reference_run SEED INDEX STRENGTH G_IC [DUMP_FILE] [--large-rotation]` (the last
+//! switches large rotations on in both models, as a refit that names them runs the reference).
 
 use czid_core::ForwardModel;
 use czid_models::dcb::Dcb;
@@ -28,7 +29,8 @@ fn main() {
     let json = serde_json::to_value(setup.models["dcb"].as_ref()).unwrap();
     let mut fields = json.clone();
     fields.as_object_mut().unwrap().remove("type");
-    let beam: Dcb = serde_json::from_value(fields).unwrap();
+    let mut beam: Dcb = serde_json::from_value(fields).unwrap();
+    beam.effects.large_rotation = a.iter().any(|v| v == "--large-rotation");
     let law = Bilinear::bk(1e5, strength, strength, g, 2.0, 2.0).unwrap();
     let t = Instant::now();
     let r = beam.simulate(&law).unwrap();
@@ -52,7 +54,7 @@ fn main() {
         }
     }
     println!("record bits hash {:016x}", h.finish());
-    if let Some(path) = a.get(5) {
+    if let Some(path) = a.get(5).filter(|v| !v.starts_with("--")) {
         let mut out = String::new();
         for c in rec.columns() {
             out += &format!("{} {}\n", c.name, c.values.iter().map(|v| format!("{v:e}")).collect::<Vec<_>>().join(" "));

@@ -223,11 +223,24 @@ fn a_clean_test_made_by_the_continuum_model_needs_no_unmodelled_effect_once_the_
     assert_eq!(d.model_form.reference["dcb"], "dcb_2d");
     // The beam model's form alone sits well away from the continuum's at this noise…
     assert!(d.model_form.shift_max > 1.0, "{:?}", d.model_form);
+    // The reference's own discretisation (its coarsened twin against it) is a smaller matter than
+    // the model form, but not nothing.
+    assert!(d.model_form.floor_rms > 0.0 && d.model_form.floor_rms < d.model_form.shift_rms, "{:?}", d.model_form);
     // …and once that is accounted for, no effect is named.
     assert_eq!(d.outcome.kind, Kind::NoneNeeded, "{}", d.verdict);
+    assert!(d.verdict.contains("own discretisation leaves it uncertain by"), "{}", d.verdict);
     assert!(
         d.verdict.starts_with("No unmodelled effect is needed at this noise and model-form level"),
         "{}",
         d.verdict
     );
+}
+
+#[test]
+fn a_bridging_tail_in_a_continuum_made_test_stands_out_from_the_floor_and_its_uncertainty() {
+    let d = diagnose_made_by(1.0, true);
+    assert!(d.model_form.applied() && d.model_form.floor_rms > 0.0, "{:?}", d.model_form);
+    assert!(!d.base.at_noise_level || d.base.structure_p <= 1e-3, "{}", d.verdict);
+    assert_eq!(d.outcome.kind, Kind::Cause, "{}", d.verdict);
+    assert_eq!(d.outcome.cause.as_deref(), Some("fibre_bridging"), "{}", d.verdict);
 }

@@ -40,6 +40,18 @@ impl Default for ContinuumMesh {
     }
 }
 
+impl ContinuumMesh {
+    /// The same mesh with one element fewer through each arm (`None` below three): the
+    /// through-thickness discretisation is what keeps a few-element arm from the converged
+    /// bending and shear near the crack front, while the interface elements must stay (they
+    /// resolve the cohesive zone). A model run on both tells how far its own discretisation is
+    /// from converged ([`czid_core::ForwardModel::coarsened`]).
+    pub fn coarsened(&self) -> Option<ContinuumMesh> {
+        (self.thickness_elements > 2)
+            .then(|| ContinuumMesh { thickness_elements: self.thickness_elements - 1, ..*self })
+    }
+}
+
 /// Largest number of nodes a continuum mesh may have (about 0.5 GB with the band LU).
 pub const MAX_NODES: usize = 2_000_000;
 
