@@ -301,8 +301,13 @@ pub struct PreparedCase {
     pub options: Options,
 }
 
-/// The planted model's record; a planted model that stops early is drawn again (a few times),
-/// and the redraws counted in `out`.
+/// Redraws of a planted effect's size whose model stops early or refuses it (a root compliance
+/// too large for a steep law is refused at once, see
+/// [`czid_models::effects::ROOT_COMPLIANCE_SHARE`]).
+const PLANT_REDRAWS: usize = 20;
+
+/// The planted model's record; a planted model that stops early or is refused is drawn again (up
+/// to [`PLANT_REDRAWS`] times), and the redraws counted in `out`.
 fn planted_record(
     base: &Setup,
     effect: Option<&dyn CandidateEffect>,
@@ -320,7 +325,7 @@ fn planted_record(
         let model = made_by.model(true_setup.models[family.name()].as_ref())?;
         match model.simulate(true_setup.law.as_ref()) {
             Ok(r) => return Ok(r),
-            Err(_) if attempt < 5 && effect.is_some() => {
+            Err(_) if attempt < PLANT_REDRAWS && effect.is_some() => {
                 attempt += 1;
                 out.redraws = attempt;
                 *size = effect.and_then(|c| c.plant(rng)).unwrap_or_default();
