@@ -25,9 +25,10 @@ pub struct Block {
     pub sigma: f64,
     /// Whether σ was estimated from the data (false: given by the user).
     pub sigma_estimated: bool,
-    /// Per reading, how far (N or mm) the model-form floor itself may be off
-    /// ([`crate::diagnose::stages::model_form`]); empty: no estimate. An error of the floor is
-    /// smooth along the curve, so [`Gauge::structure_p`] counts it once per bin, not per reading.
+    /// Per reading, the estimated error (N or mm, signed) of the model-form floor itself: the
+    /// change its reference's coarsened twin makes ([`crate::diagnose::stages::model_form`]);
+    /// empty: no estimate. [`Gauge::structure_p`] allows for an error of that shape and about
+    /// that size.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub floor: Vec<f64>,
 }

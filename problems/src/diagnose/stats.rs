@@ -16,25 +16,39 @@ pub fn structure_p(r: &[f64], ranges: &[std::ops::Range<usize>]) -> f64 {
     structure_p_with_floor(r, ranges, &[])
 }
 
-/// [`structure_p`] with a smooth error of known size on top of the noise: `floor` (noise units,
-/// per reading; empty: none) is how far the model-form floor may be off at each reading. Such an
-/// error moves all readings of a bin together, so a bin's sum has the variance `L + F²` (`L`
-/// readings of white noise, `F` the sum of the bin's floor), not `L (1 + f²)`: a misfit that
-/// stays within the floor's uncertainty is not taken for structure, one well beyond it still is.
+/// Freedom of the floor's error to depart from its estimated shape, as a share of its size per
+/// bin ([`structure_p_with_floor`]). Chosen on the clean and gain-error cases of gap-bench seed 41
+/// (the smallest of 0, 0.3, 0.5 and 0.7 that calls none of its 20 clean tests structured: 0 calls
+/// one) and scored on seed 43.
+pub const FLOOR_SHAPE_FREEDOM: f64 = 0.3;
+
+/// [`structure_p`] with a smooth error of the model-form floor on top of the noise: `floor` (noise
+/// units, per reading, signed; empty: none) is the floor's estimated error `d`, the change its
+/// reference's coarsened twin makes. The error is taken as `κ d + e`, `κ ~ N(0, 1)` an unknown
+/// scale of that shape and `e` a shape-free part of [`FLOOR_SHAPE_FREEDOM`] times its size,
+/// independent from bin to bin. With `S_b` a bin's residual sum, `D_b` its floor sum and `L_b`
+/// its readings, the bin sums then have the covariance `V + D Dᵀ`, `V = diag(L_b + (ε D_b)²)`, and
+/// `Sᵀ (V + D Dᵀ)⁻¹ S = Σ S²/v − (Σ S D/v)² / (1 + Σ D²/v)` is `χ²` with one degree per bin. A
+/// misfit along the floor's own shape, of about its size, is not taken for structure; one of
+/// another shape is, almost as surely as without a floor.
 pub fn structure_p_with_floor(r: &[f64], ranges: &[std::ops::Range<usize>], floor: &[f64]) -> f64 {
-    let (mut stat, mut bins) = (0.0, 0usize);
+    let (mut ss, mut sd, mut dd, mut bins) = (0.0, 0.0, 0.0, 0usize);
     for range in ranges {
         for (k, bin) in r[range.clone()].chunks(STRUCTURE_BIN).enumerate() {
             if 2 * bin.len() < STRUCTURE_BIN {
                 continue;
             }
             let start = range.start + k * STRUCTURE_BIN;
-            let f: f64 = floor.get(start..start + bin.len()).map_or(0.0, |f| f.iter().sum());
+            let d: f64 = floor.get(start..start + bin.len()).map_or(0.0, |f| f.iter().sum());
+            let v = bin.len() as f64 + (FLOOR_SHAPE_FREEDOM * d).powi(2);
             let sum: f64 = bin.iter().sum();
-            stat += sum * sum / (bin.len() as f64 + f * f);
+            ss += sum * sum / v;
+            sd += sum * d / v;
+            dd += d * d / v;
             bins += 1;
         }
     }
+    let stat = ss - sd * sd / (1.0 + dd);
     if bins == 0 {
         return 1.0;
     }
@@ -163,24 +177,29 @@ mod tests {
     }
 
     #[test]
-    fn a_smooth_misfit_within_the_floor_uncertainty_is_not_structure_and_one_well_beyond_it_is() {
+    fn a_misfit_along_the_floors_error_is_not_structure_and_one_of_another_shape_is() {
         let n = 450;
-        let smooth = |i: usize, a: f64| a * (i as f64 / 90.0).sin();
-        let (mut within, mut beyond, mut none) = (0, 0, 0);
+        // The floor's estimated error: smooth, 0.6 noise units.
+        let d: Vec<f64> = (0..n).map(|i| 0.6 * (i as f64 / 90.0).sin()).collect();
+        let (mut along, mut scaled, mut other, mut plain) = (0, 0, 0, 0);
         for seed in 0..20 {
             let e = white(n, 2000 + seed);
-            // A model-form error of 0.6 noise units whose size the floor states (0.6 per reading).
-            let r: Vec<f64> = e.iter().enumerate().map(|(i, v)| v + smooth(i, 0.6)).collect();
-            within += usize::from(structure_p_with_floor(&r, &[0..n], &vec![0.6; n]) <= 1e-3);
-            none += usize::from(structure_p(&r, &[0..n]) <= 1e-3);
-            // An effect rising to 3 noise units (five times the floor's uncertainty) on top of it.
-            let big: Vec<f64> =
-                e.iter().enumerate().map(|(i, v)| v + smooth(i, 0.6) + 3.0 * (i as f64 / n as f64)).collect();
-            beyond += usize::from(structure_p_with_floor(&big, &[0..n], &vec![0.6; n]) <= 1e-3);
+            let with = |k: f64| -> Vec<f64> { e.iter().zip(&d).map(|(v, f)| v + k * f).collect() };
+            let r = with(1.0);
+            along += usize::from(structure_p_with_floor(&r, &[0..n], &d) <= 1e-3);
+            plain += usize::from(structure_p(&r, &[0..n]) <= 1e-3);
+            // Twice the estimated size: the scale of the floor's error is not known.
+            scaled += usize::from(structure_p_with_floor(&with(2.0), &[0..n], &d) <= 1e-3);
+            // An effect of another shape, rising to 1.5 noise units, on top of the floor's error.
+            let ramp: Vec<f64> = r.iter().enumerate().map(|(i, v)| v + 1.5 * i as f64 / n as f64).collect();
+            other += usize::from(structure_p_with_floor(&ramp, &[0..n], &d) <= 1e-3);
         }
-        assert!(none >= 19, "without the floor the model-form error is structure in {none}/20");
-        assert!(within <= 1, "within the floor's uncertainty flagged in {within}/20");
-        assert!(beyond >= 19, "beyond the floor's uncertainty flagged in only {beyond}/20");
+        assert!(plain >= 17, "without the floor its error is structure in only {plain}/20");
+        assert!(
+            along <= 1 && scaled <= 1,
+            "the floor's own error flagged in {along}/20 and {scaled}/20 at twice its size"
+        );
+        assert!(other >= 19, "an effect of another shape flagged in only {other}/20");
         // No floor is the plain test.
         let e = white(n, 7);
         assert_eq!(structure_p_with_floor(&e, &[0..n], &[]), structure_p(&e, &[0..n]));

@@ -86,10 +86,10 @@ fn coarsened_setup(reference: &Setup) -> Option<Setup> {
     Some(Setup { law, models })
 }
 
-/// Per block and reading, the uncertainty of the model-form shift `raw` (noise units, unsmoothed
-/// `(base − reference)/σ`): `|smooth(raw − raw_coarse)|`, the change the reference's
-/// coarsened twin makes; `None` when there is no twin or its run stopped early (the floor is then
-/// taken as exact, as before this estimate existed).
+/// Per block and reading, the estimated error of the model-form shift `raw` (noise units,
+/// unsmoothed `(base − reference)/σ`): `smooth(raw_coarse − raw)`, signed, the change the
+/// reference's coarsened twin makes; `None` when there is no twin or its run stopped early (the
+/// floor is then taken as exact).
 fn floor_uncertainty(gauge: &Gauge, reference: &Setup, raw: &[f64], r: &[f64]) -> Result<Option<Vec<f64>>> {
     let Some(coarse) = coarsened_setup(reference) else { return Ok(None) };
     let misfit = Misfit::of(gauge, &coarse)?;
@@ -99,7 +99,7 @@ fn floor_uncertainty(gauge: &Gauge, reference: &Setup, raw: &[f64], r: &[f64]) -
     let mut out = Vec::with_capacity(gauge.len());
     for (b, range) in gauge.blocks.iter().zip(gauge.ranges()) {
         let d: Vec<f64> = range.map(|i| (misfit.r[i] - r[i]) - raw[i]).collect();
-        out.extend(smooth(&b.x, &d).into_iter().map(f64::abs));
+        out.extend(smooth(&b.x, &d));
     }
     Ok(Some(out))
 }
