@@ -230,9 +230,10 @@ impl Effects {
 }
 
 /// Largest share `2 c_r |dT/du|` of the law's softening that root compliance may give back (see
-/// [`Effects::check_root_compliance`]). Measured on the paper DCB with bilinear laws of 27–80 MPa:
-/// the windowed path follows shares up to 0.69 in 3–10× the steps of the base model; from 0.79 it
-/// fails and the whole-mesh fallback takes 20–90 s or fails too.
+/// [`Effects::check_root_compliance`]). On the paper's DCB with a 27 MPa, 0.744 N/mm bilinear law a
+/// share of 0.79 already fails on the window, and the whole-mesh fallback took 28 s; at 0.89
+/// it fails altogether. Below the limit steep laws can still leave the window (from a share of 0.3
+/// at 60 MPa): `cargo run --release -p czid-models --example root_compliance_limit` tabulates it.
 pub const ROOT_COMPLIANCE_SHARE: f64 = 0.75;
 
 /// The steepest softening slope `|dT_n/du_n|` (MPa/mm) of `law` on a monotonic mode-I opening to

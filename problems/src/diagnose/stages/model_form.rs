@@ -10,7 +10,10 @@
 //! each curve, is the model-form misfit: the data are shifted by it (`y + (beam − reference)`),
 //! the base fit polished again, and every later stage (scores, refits, transfer) judges the
 //! candidates against the noise on data whose model-form part is accounted for. The base model
-//! then stands for the reference model at the cost of one reference run.
+//! then stands for the reference model at the cost of one reference run. Where the reference
+//! has a coarsened twin ([`czid_core::ForwardModel::coarsened`]), the twin's shift minus the
+//! reference's is the floor's own error, which the structure test allows for
+//! ([`crate::diagnose::stats::structure_p_with_floor`]).
 
 use super::base::Base;
 use crate::diagnose::gauge::{Gauge, Misfit};
@@ -90,7 +93,7 @@ fn coarsened_setup(reference: &Setup) -> Option<Setup> {
 /// unsmoothed `(base − reference)/σ`): `smooth(raw_coarse − raw)`, signed, the change the
 /// reference's coarsened twin makes; `None` when there is no twin or its run stopped early (the
 /// floor is then taken as exact).
-fn floor_uncertainty(gauge: &Gauge, reference: &Setup, raw: &[f64], r: &[f64]) -> Result<Option<Vec<f64>>> {
+fn floor_error(gauge: &Gauge, reference: &Setup, raw: &[f64], r: &[f64]) -> Result<Option<Vec<f64>>> {
     let Some(coarse) = coarsened_setup(reference) else { return Ok(None) };
     let misfit = Misfit::of(gauge, &coarse)?;
     if !misfit.failures.is_empty() {
@@ -135,7 +138,7 @@ pub fn account(base: &Base) -> Result<(Option<Gauge>, ModelForm)> {
     let (mut gauge, shift, raw) = shifted;
     let n = shift.len().max(1) as f64;
     let mut floor_rms = 0.0;
-    if let Some(floor) = floor_uncertainty(&base.gauge, &setup, &raw, &base.misfit.r)? {
+    if let Some(floor) = floor_error(&base.gauge, &setup, &raw, &base.misfit.r)? {
         floor_rms = (floor.iter().map(|f| f * f).sum::<f64>() / n).sqrt();
         for (b, range) in gauge.blocks.iter_mut().zip(base.gauge.ranges()) {
             b.floor = floor[range].iter().map(|f| f * b.sigma).collect();
