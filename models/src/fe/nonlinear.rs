@@ -787,7 +787,12 @@ impl<'a> Solver<'a> {
             }
             it += 1;
             secant_left = secant_left.saturating_sub(1);
-            r_prev = rmax;
+            // The line search compares force residuals of iterates that meet the control
+            // constraint (which a full correction does exactly, the constraint being linear). An
+            // iterate that misses it, such as a step's predictor, has no comparable residual: at
+            // the first step from rest the force residual is zero and every correction would be
+            // halved back towards it, spending the iterations on a point that cannot be right.
+            r_prev = if cres.abs() <= 1e-9 * ctl.abs().max(1e-9) { rmax } else { f64::INFINITY };
             alpha = 1.0;
             self.tangent();
             for &d in &self.p.fixed {
