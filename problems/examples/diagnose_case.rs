@@ -6,6 +6,8 @@
 //!     --truth continuum --cases 4 --nulls 6 --seed 31 \
 //!     --effects fibre_bridging,machine_compliance,seating_toe,load_offset,crack_length_offset,displacement_gain \
 //!     --case 21 [--out summary.json]
+//! cargo run --release -p czid-problems --example diagnose_case -- \
+//!     --family beam --truth beam --cases 20 --nulls 20 --seed 7 --case 2
 //! ```
 
 use czid_problems::diagnose::bench::{BenchOptions, Family, Plan};
@@ -22,7 +24,7 @@ fn main() {
         nulls: arg("--nulls").map_or(6, |v| v.parse().expect("--nulls")),
         seed: arg("--seed").map_or(31, |v| v.parse().expect("--seed")),
         effects: arg("--effects").map(|v| v.split(',').map(String::from).collect()).unwrap_or_default(),
-        family: Family::Dcb,
+        family: arg("--family").map_or(Family::Dcb, |v| v.parse().expect("--family")),
         truth: arg("--truth").unwrap_or_else(|| "continuum".into()).parse().expect("--truth"),
     };
     let index: usize = arg("--case").expect("--case N").parse().expect("--case");
@@ -54,6 +56,7 @@ fn main() {
     let seconds = diagnosing.elapsed().as_secs_f64();
     println!("diagnosis: {seconds:.1} s");
     print_tally("diagnosis total", &tally::snapshot(), &before);
+    println!("base fit at {:?}", d.base.parameters.iter().map(|p| p.value).collect::<Vec<_>>());
     println!(
         "base: chi2/dof {:.4}, structure p {:.3e}, model-form shift {:.3} (floor uncertainty {:.3}) noise units, evaluations {}",
         d.base.reduced_chi2, d.base.structure_p, d.model_form.shift_rms, d.model_form.floor_rms, d.base.evaluations
@@ -64,6 +67,8 @@ fn main() {
                 "  refit {:22} evaluations {:4} shrinkage {:.4} dBIC {:.1} reestimated {:?}",
                 c.name, r.evaluations, r.shrinkage, r.delta_bic, r.chi2_reestimated
             );
+            let values: Vec<f64> = r.parameters.iter().chain(&r.effect).map(|v| v.value).collect();
+            println!("    chi2 {:.1} at {values:?}", r.chi2);
         }
     }
     println!("verdict: {:?} cause {:?} more_missing {}", d.outcome.kind, d.outcome.cause, d.outcome.more_missing);
