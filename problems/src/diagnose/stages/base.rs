@@ -56,7 +56,7 @@ impl Base {
 /// Distance to a bound (unit-cube coordinates) below which a fitted parameter sits at the bound.
 const AT_BOUND: f64 = 1e-3;
 /// Where a parameter found at a bound is started again (unit-cube coordinates).
-const RESTARTS: [f64; 3] = [0.25, 0.5, 0.75];
+pub const RESTARTS: [f64; 3] = [0.25, 0.5, 0.75];
 
 /// Indices of the coordinates of `u` at a bound of the unit cube.
 pub fn at_bound(u: &[f64]) -> Vec<usize> {

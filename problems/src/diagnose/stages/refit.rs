@@ -1,12 +1,12 @@
 //! How far: a candidate switched on and refitted with the fitted parameters, its realised
 //! shrinkage of the misfit (overall and per regime) and its information criteria.
 
-use super::base::{aic_bic, Base, POLISH_STEP};
+use super::base::{aic_bic, at_bound, Base, POLISH_STEP, RESTARTS};
 use super::ranking::Ranked;
 use crate::diagnose::candidate::CandidateEffect;
 use crate::diagnose::gauge::{Gauge, Misfit};
 use crate::diagnose::regimes::{self, Regime};
-use crate::diagnose::run::{Refit, RegimeShrinkage, Value};
+use crate::diagnose::run::{Refit, RegimeShrinkage, Value, NOISE_LEVEL};
 use crate::diagnose::score::{Linearisation, Score, Sensitivity};
 use czid_core::{Parameter, Result};
 use czid_optimizers::least_squares::{self, JacobianUpdates, LmOptions, Parallel};
@@ -144,7 +144,30 @@ pub fn refit(
         m.columns_mut(p, params.len()).copy_from(&sens.columns);
         m
     };
-    let mut out = refit_on(&base.gauge, base, c, &params, &start(base, c, sens, s, &params), Some(jac0.clone()))?;
+    let first = start(base, c, sens, s, &params);
+    let mut out = refit_on(&base.gauge, base, c, &params, &first, Some(jac0.clone()))?;
+    // A base fit stopped at a bound has distorted the fitted parameters to absorb what the
+    // effect explains, and a refit from there has to travel back across the range (a beam's
+    // bond strength at its lower bound when the deflection is offset). When the refit leaves
+    // structure behind, those parameters are started again at a quarter, the middle and three
+    // quarters of their range, as the base fit's are, and the best refit kept.
+    let stuck = at_bound(&base.u);
+    if !c.discrete() && !stuck.is_empty() && base.gauge.structure_p(&out.misfit.r) <= NOISE_LEVEL {
+        use rayon::prelude::*;
+        let starts: Vec<Vec<f64>> = RESTARTS
+            .into_iter()
+            .map(|w| {
+                let mut v = first.clone();
+                for &j in &stuck {
+                    v[j] = w;
+                }
+                v
+            })
+            .collect();
+        let again: Vec<Result<RefitOutcome>> =
+            starts.par_iter().map(|v| refit_on(&base.gauge, base, c, &params, v, None)).collect();
+        keep_best(&mut out, again);
+    }
     if !c.discrete() && out.misfit.rss() > (1.0 - STALLED) * base.chi2 {
         use rayon::prelude::*;
         let starts: Vec<Vec<f64>> = PRIMARY_STARTS
