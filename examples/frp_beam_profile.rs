@@ -12,7 +12,8 @@ fn main() {
     let runs: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(10);
     let mut beam = FrpBeam::paper().unwrap();
     if case == "identify" {
-        beam.control.damage_tolerance = 1.0;
+        let step = beam.control.elongation_step;
+        beam.control.set_fixed_schedule(step);
     }
     // Optional overrides: elongation step (mm), interface element (mm), damage tolerance.
     let arg = |i: usize| args.get(i).and_then(|s| s.parse::<f64>().ok());

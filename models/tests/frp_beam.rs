@@ -344,8 +344,7 @@ fn the_first_step_from_rest_converges_for_a_law_that_once_failed_there() {
         let mut beam = FrpBeam::paper().unwrap();
         beam.section.concrete.elastic_modulus = modulus;
         if fixed_schedule {
-            beam.control.elongation_step = 0.025;
-            beam.control.damage_tolerance = 1.0;
+            beam.control.set_fixed_schedule(0.025);
         }
         beam.control.max_elongation = 0.5;
         let run = beam.run(&law, false).unwrap_or_else(|e| panic!("E = {modulus} MPa: {}", e.error));

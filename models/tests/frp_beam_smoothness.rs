@@ -75,8 +75,7 @@ const IDENTIFICATION_PATH: Path = Path { step: 0.025, end: 24.5, max_cuts: 3 };
 fn run(path: Path, strength_t: f64, u_c_t: f64) -> BeamRun {
     let law = StCzm::sawtooth(12.0, 0.02513, 0.1457, strength_t, 0.02897, u_c_t).unwrap();
     let mut beam = FrpBeam::paper().unwrap();
-    beam.control.damage_tolerance = 1.0;
-    beam.control.elongation_step = path.step;
+    beam.control.set_fixed_schedule(path.step);
     let run = beam.run(&law, true).unwrap();
     // The schedule is fixed; a step cut once when Newton's method fails is the only change.
     assert!(run.stats.cuts <= path.max_cuts, "σ_t = {strength_t}, Δu_t,c = {u_c_t}: {} cuts", run.stats.cuts);

@@ -166,6 +166,18 @@ pub struct BeamControl {
     pub max_deflection: Option<f64>,
 }
 
+impl BeamControl {
+    /// A fixed step schedule of `elongation_step` (mm): no step is repeated smaller because the
+    /// law's damage departs from the extrapolated one (a departure never exceeds 1). Every output
+    /// then moves smoothly with the law's parameters, which finite-difference Jacobians need;
+    /// the default halving decisions change with the parameters and make outputs jump (the path
+    /// of `examples/frp-beam/identify.toml` and of `czid gap-bench --family beam`).
+    pub fn set_fixed_schedule(&mut self, elongation_step: f64) {
+        self.elongation_step = elongation_step;
+        self.damage_tolerance = 1.0;
+    }
+}
+
 impl Default for BeamControl {
     fn default() -> Self {
         BeamControl {

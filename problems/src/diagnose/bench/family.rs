@@ -230,8 +230,7 @@ impl Family {
                 // jumped by 1.3 (noise units squared, 244 readings) between failure slips 0.01 %
                 // apart (seed 7, case 2), which the finite differences of the refits cannot
                 // follow; on the fixed schedule it is smooth and monotone there.
-                beam.control.elongation_step = BEAM_STEP;
-                beam.control.damage_tolerance = 1.0;
+                beam.control.set_fixed_schedule(BEAM_STEP);
                 (Box::new(law), Box::new(beam))
             }
         };

@@ -153,7 +153,6 @@ pub fn refit(
     // quarters of their range, as the base fit's are, and the best refit kept.
     let stuck = at_bound(&base.u);
     if !c.discrete() && !stuck.is_empty() && base.gauge.structure_p(&out.misfit.r) <= NOISE_LEVEL {
-        use rayon::prelude::*;
         let starts: Vec<Vec<f64>> = RESTARTS
             .into_iter()
             .map(|w| {
@@ -164,26 +163,20 @@ pub fn refit(
                 v
             })
             .collect();
-        let again: Vec<Result<RefitOutcome>> =
-            starts.par_iter().map(|v| refit_on(&base.gauge, base, c, &params, v, None)).collect();
-        keep_best(&mut out, again);
+        keep_best(&mut out, refits_from(base, c, &params, &starts, None));
     }
     if !c.discrete() && out.misfit.rss() > (1.0 - STALLED) * base.chi2 {
-        use rayon::prelude::*;
         let starts: Vec<Vec<f64>> = PRIMARY_STARTS
             .into_iter()
             .filter(|w| (out.v[p] - w).abs() >= 0.1)
             .map(|w| base.u.iter().copied().chain(std::iter::once(w)).chain(out.v[p + 1..].iter().copied()).collect())
             .collect();
-        let again: Vec<Result<RefitOutcome>> =
-            starts.par_iter().map(|v| refit_on(&base.gauge, base, c, &params, v, Some(jac0.clone()))).collect();
-        keep_best(&mut out, again);
+        keep_best(&mut out, refits_from(base, c, &params, &starts, Some(&jac0)));
     }
     // An effect of several parameters can trade one against another along a valley (a bridging
     // tail's strength against its length): the refit is repeated from other values of every
     // parameter but the first, and the best kept.
     if !c.discrete() && params.len() > 1 {
-        use rayon::prelude::*;
         let starts: Vec<Vec<f64>> = (1..params.len())
             .flat_map(|j| SECONDARY_STARTS.into_iter().map(move |w| (j, w)))
             .filter(|&(j, w)| (out.v[p + j] - w).abs() >= 0.1)
@@ -193,12 +186,23 @@ pub fn refit(
                 v
             })
             .collect();
-        // Side by side (a refit runs one simulation per step); the best kept, the first of equals.
-        let again: Vec<Result<RefitOutcome>> =
-            starts.par_iter().map(|v| refit_on(&base.gauge, base, c, &params, v, out.jacobian.clone())).collect();
-        keep_best(&mut out, again);
+        let jacobian = out.jacobian.clone();
+        keep_best(&mut out, refits_from(base, c, &params, &starts, jacobian.as_ref()));
     }
     Ok(out)
+}
+
+/// Refits from each of `starts`, side by side (a refit runs one simulation per step), each from
+/// `jacobian` when given (else differenced afresh).
+fn refits_from(
+    base: &Base,
+    c: &dyn CandidateEffect,
+    params: &[Parameter],
+    starts: &[Vec<f64>],
+    jacobian: Option<&DMatrix<f64>>,
+) -> Vec<Result<RefitOutcome>> {
+    use rayon::prelude::*;
+    starts.par_iter().map(|v| refit_on(&base.gauge, base, c, params, v, jacobian.cloned())).collect()
 }
 
 /// Keeps in `out` the best of it and the refits `again` (the first of equals), counting every
