@@ -15,7 +15,11 @@ use super::jacobian::{jacobian, FiniteDifferences};
 use super::ResidualSource;
 use nalgebra::DMatrix;
 
-/// Initial damping relative to the largest diagonal entry of JᵀJ (Nielsen's τ).
+/// Initial damping (Nielsen's τ). The damping term is `μ diag(JᵀJ)` (Marquardt's scaling), which
+/// already carries each coordinate's scale, so `μ` is a pure number and starts at τ. (Scaled once
+/// more by the largest diagonal entry, as Levenberg's `μ I` is, the damping would grow with the
+/// square of the misfit: a refit starting 10³ noise units from the data took first steps of
+/// 10⁻⁸ of its range, below the forward model's own noise, and stalled there.)
 const TAU: f64 = 1e-3;
 /// With Broyden updates, rejected steps in a row after which the Jacobian is differenced afresh
 /// (or the run ends when no fresh Jacobian is left).
@@ -352,8 +356,7 @@ impl<'a, S: ResidualSource> Run<'a, S> {
     }
 
     fn reset_damping(&mut self) {
-        let n = self.free.len();
-        self.mu = TAU * (0..n).map(|i| self.a[i * n + i]).fold(0.0, f64::max);
+        self.mu = TAU;
         self.nu = 2.0;
     }
 }
@@ -514,6 +517,31 @@ mod tests {
         let res = minimize(&f, &[-1.2, 1.0], &opts, None).unwrap();
         assert!((res.z[0] - 1.0).abs() < 1e-6 && (res.z[1] - 1.0).abs() < 1e-6, "{:?}", res.z);
         assert!(res.cost < 1e-12, "{}", res.cost);
+    }
+
+    #[test]
+    fn the_steps_do_not_depend_on_the_units_of_the_residuals() {
+        // Residuals in noise units can be 10⁴ times those of the same fit normalised by the data:
+        // the points evaluated must be the same. (With the damping started at τ max diag(JᵀJ),
+        // the fit in the larger units took first steps 10⁸ times shorter.)
+        let points = |scale: f64| {
+            let seen = std::sync::Mutex::new(Vec::new());
+            let f = Parallel(|z: &[f64]| -> Result<Vec<f64>, ()> {
+                seen.lock().unwrap().push(z.to_vec());
+                let (x, y) = (z[0], z[1]);
+                Ok(vec![scale * 10.0 * (y - x * x), scale * (1.0 - x), scale * 0.1 * (x + y - 1.5)])
+            });
+            let res = minimize(&f, &[0.05, 0.9], &boxed(vec![]), None).unwrap();
+            assert!(res.evaluations > 20, "{}", res.evaluations);
+            seen.into_inner().unwrap()
+        };
+        let (small, large) = (points(1.0), points(1e4));
+        // The first thirty (near the optimum, rounding in the differences tells the two apart).
+        for (k, (a, b)) in small.iter().zip(&large).take(30).enumerate() {
+            for (u, v) in a.iter().zip(b) {
+                assert!((u - v).abs() < 1e-9, "evaluation {k}: {a:?} against {b:?}");
+            }
+        }
     }
 
     #[test]
