@@ -34,6 +34,17 @@ struct LogLines {
     every: usize,
     next: usize,
     start: std::time::Instant,
+    /// The last progress observed (evaluations, best value, failures) and whether it was printed.
+    last: Option<(usize, f64, usize, bool)>,
+}
+
+impl LogLines {
+    fn print(&self, total: u64, evaluations: usize, best: f64, failures: usize) {
+        eprintln!(
+            "progress: {evaluations}/{total} evaluations, best {best:.6e}, {failures} failed, {:.1} s",
+            self.start.elapsed().as_secs_f64()
+        );
+    }
 }
 
 impl ProgressBar {
@@ -52,6 +63,7 @@ impl ProgressBar {
             every,
             next: every,
             start: std::time::Instant::now(),
+            last: None,
         });
         ProgressBar { bar, lines }
     }
@@ -66,8 +78,20 @@ impl ProgressBar {
 
     /// Ends the bar where the run ended: at the evaluations observed last, which a run that
     /// converged or was stopped leaves short of the budget (the bar does not jump to the end).
-    pub fn finish(&self) {
+    /// In a log, the last progress is printed if its line was not (the run ended between two
+    /// tenths of the budget), so the log ends where the run did.
+    pub fn finish(&mut self) {
         self.bar.abandon();
+        if let Some(l) = &self.lines {
+            if let Some((evaluations, best, failures, false)) = l.last {
+                l.print(self.bar.length().unwrap_or(0), evaluations, best, failures);
+            }
+        }
+        if let Some(l) = &mut self.lines {
+            if let Some(last) = &mut l.last {
+                last.3 = true;
+            }
+        }
     }
 
     /// Evaluations the bar shows.
@@ -81,17 +105,12 @@ impl Observer for ProgressBar {
         self.bar.set_position(p.evaluations as u64);
         self.bar.set_message(format!("best {:.6e}  failed {}", p.best_value, p.failures));
         if let Some(l) = &mut self.lines {
-            if p.evaluations >= l.next {
-                let total = self.bar.length().unwrap_or(0);
-                eprintln!(
-                    "progress: {}/{total} evaluations, best {:.6e}, {} failed, {:.1} s",
-                    p.evaluations,
-                    p.best_value,
-                    p.failures,
-                    l.start.elapsed().as_secs_f64()
-                );
+            let printed = p.evaluations >= l.next;
+            if printed {
+                l.print(self.bar.length().unwrap_or(0), p.evaluations, p.best_value, p.failures);
                 l.next = (p.evaluations / l.every + 1) * l.every;
             }
+            l.last = Some((p.evaluations, p.best_value, p.failures, printed));
         }
         true
     }
