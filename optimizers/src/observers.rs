@@ -34,8 +34,9 @@ struct LogLines {
     every: usize,
     next: usize,
     start: std::time::Instant,
-    /// The last progress observed (evaluations, best value, failures) and whether it was printed.
-    last: Option<(usize, f64, usize, bool)>,
+    /// The last progress observed (evaluations, best value, failures) when its line was not
+    /// printed: the run may end before the next tenth of the budget.
+    unprinted: Option<(usize, f64, usize)>,
 }
 
 impl LogLines {
@@ -63,7 +64,7 @@ impl ProgressBar {
             every,
             next: every,
             start: std::time::Instant::now(),
-            last: None,
+            unprinted: None,
         });
         ProgressBar { bar, lines }
     }
@@ -82,14 +83,10 @@ impl ProgressBar {
     /// tenths of the budget), so the log ends where the run did.
     pub fn finish(&mut self) {
         self.bar.abandon();
-        if let Some(l) = &self.lines {
-            if let Some((evaluations, best, failures, false)) = l.last {
-                l.print(self.bar.length().unwrap_or(0), evaluations, best, failures);
-            }
-        }
+        let total = self.bar.length().unwrap_or(0);
         if let Some(l) = &mut self.lines {
-            if let Some(last) = &mut l.last {
-                last.3 = true;
+            if let Some((evaluations, best, failures)) = l.unprinted.take() {
+                l.print(total, evaluations, best, failures);
             }
         }
     }
@@ -105,12 +102,12 @@ impl Observer for ProgressBar {
         self.bar.set_position(p.evaluations as u64);
         self.bar.set_message(format!("best {:.6e}  failed {}", p.best_value, p.failures));
         if let Some(l) = &mut self.lines {
-            let printed = p.evaluations >= l.next;
-            if printed {
+            l.unprinted = Some((p.evaluations, p.best_value, p.failures));
+            if p.evaluations >= l.next {
                 l.print(self.bar.length().unwrap_or(0), p.evaluations, p.best_value, p.failures);
                 l.next = (p.evaluations / l.every + 1) * l.every;
+                l.unprinted = None;
             }
-            l.last = Some((p.evaluations, p.best_value, p.failures, printed));
         }
         true
     }
