@@ -119,6 +119,14 @@ enum Command {
         /// Objective value that counts as success.
         #[arg(long, default_value_t = 1e-3)]
         target: f64,
+        /// Continue an interrupted comparison in the output folder: its finished runs are kept,
+        /// the one it was in continues from its checkpoint.
+        #[arg(long)]
+        resume: bool,
+        /// Abort the process once the runs have done this many evaluations, as a kill would (for
+        /// tests of interruption and resume).
+        #[arg(long, hide = true)]
+        abort_after_evaluations: Option<usize>,
         #[command(flatten)]
         out: OutArgs,
         #[command(flatten)]
@@ -226,12 +234,20 @@ fn main() -> ExitCode {
             outcome
         }
         Command::Synthesize { truth, out, force } => run_synthesize(&truth, &out, force),
-        Command::Compare { problem, optimizers, seeds, budget, target, out, set } => {
+        Command::Compare { problem, optimizers, seeds, budget, target, resume, abort_after_evaluations, out, set } => {
             let cluster = Cluster::join();
             if cluster.is_worker() {
                 return serve(&cluster, &problem, &set.sets, &[]);
             }
-            let opts = CompareOptions { optimizers, seeds, budget, target, spread: cluster.spread() };
+            let opts = CompareOptions {
+                optimizers,
+                seeds,
+                budget,
+                target,
+                spread: cluster.spread(),
+                resume,
+                abort_after: abort_after_evaluations,
+            };
             let outcome = run_compare(&problem, &set.sets, &out, &opts);
             cluster.finish("evaluations");
             outcome
@@ -394,7 +410,7 @@ fn run_synthesize(truth: &Path, out: &Path, force: bool) -> Result<(), CzError> 
 
 fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &CompareOptions) -> Result<(), CzError> {
     let problem = read_problem(problem, sets)?;
-    let dir = OutputDir::create(&out.out, out.force, false)?;
+    let dir = OutputDir::create(&out.out, out.force, opts.resume)?;
     let runs = compare(&problem, opts, &dir)?;
     println!("{:<20} {:>6} {:>12} {:>12} {:>10}", "optimizer", "runs", "median f", "success", "median s");
     for name in &opts.optimizers {

@@ -113,3 +113,67 @@ fn a_run_that_fails_to_start_leaves_no_files_in_the_way() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     std::fs::remove_dir_all(out).ok();
 }
+
+/// A comparison's table without its wall-time column (the only column a resume changes).
+fn without_wall_times(dir: &Path) -> String {
+    let text = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let wall = header.iter().position(|h| *h == "wall_seconds").unwrap();
+    text.lines()
+        .map(|l| l.split(',').enumerate().filter(|(i, _)| *i != wall).map(|(_, v)| v).collect::<Vec<_>>().join(","))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn compare(out: &Path, budget: &str, extra: &[&str]) -> Output {
+    // The paper's DCB: its runs are cheaper than DCB-01's across MIGA's samples of the bounds.
+    let mut args = vec![
+        "compare",
+        "examples/paper-dcb/problem.toml",
+        "--optimizers",
+        "miga,nelder-mead",
+        "--seeds",
+        "2",
+        "--budget",
+        budget,
+    ];
+    args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+    args.extend_from_slice(extra);
+    czid(&args)
+}
+
+#[test]
+fn an_interrupted_comparison_resumes_to_the_uninterrupted_one() {
+    let whole = scratch("compare-whole");
+    assert!(compare(&whole, "200", &[]).status.success());
+    // Killed in MIGA's second seed: the first run is kept, the second continues from its
+    // checkpoint, the other two run. (How local methods replay their journal is checked on
+    // identifications above.)
+    let cut = scratch("compare-cut");
+    let killed = compare(&cut, "200", &["--abort-after-evaluations", "300"]);
+    assert!(!killed.status.success(), "the abort did not happen");
+    assert!(cut.join("runs/miga-seed1/finished.json").exists());
+    assert!(
+        cut.join("runs/miga-seed2/checkpoint.json").exists() && !cut.join("runs/miga-seed2/finished.json").exists()
+    );
+    let rows = std::fs::read_to_string(cut.join("summary.csv")).unwrap().lines().count();
+    assert_eq!(rows, 2, "the table holds the header and the finished run");
+    let resumed = compare(&cut, "200", &["--resume"]);
+    let err = String::from_utf8_lossy(&resumed.stderr).into_owned();
+    assert!(resumed.status.success(), "{err}");
+    assert_eq!(err.matches("(finished before the resume)").count(), 1, "{err}");
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(cut.join("runs/miga-seed2/run.json")).unwrap()).unwrap();
+    assert_eq!(run["resumed"], 1, "the interrupted run continued from its checkpoint");
+    assert_eq!(without_wall_times(&cut), without_wall_times(&whole));
+    assert_eq!(
+        std::fs::read_to_string(cut.join("convergence.csv")).unwrap(),
+        std::fs::read_to_string(whole.join("convergence.csv")).unwrap()
+    );
+    // Another budget is another comparison: refused, not mixed in.
+    let other = compare(&cut, "300", &["--resume"]);
+    let err = String::from_utf8_lossy(&other.stderr).into_owned();
+    assert!(!other.status.success() && err.contains("budget: 200 before, 300 now"), "{err}");
+    std::fs::remove_dir_all(cut).ok();
+    std::fs::remove_dir_all(whole).ok();
+}

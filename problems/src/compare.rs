@@ -4,13 +4,25 @@
 //! time, identified values), `convergence.csv` (best-so-far per run on a common evaluation grid),
 //! and plots: convergence (median and quartile band per optimizer) and final objective per
 //! optimizer.
+//!
+//! A comparison on a slow model runs for hours, so nothing of it is lost to an interruption. Each
+//! run works in its own folder, `runs/<optimizer>-seed<k>/`, as an identification does (`run.json`
+//! with the run's [`Fingerprint`], `checkpoint.json` after every iteration of a global method, the
+//! journal `evaluations.jsonl` of a local one), and leaves `finished.json` when it ends; the two
+//! tables are rewritten after every run. `resume` keeps the finished runs, continues the
+//! interrupted one where it stopped and runs the rest: the outputs are those of the uninterrupted
+//! comparison, wall times apart.
 
-use crate::identify::optimize;
+use crate::identify::{optimize_with, AbortAfter};
 use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
 use crate::problem_file::LoadedProblem;
-use czid_core::{Budget, CzError, NoObserver, Result};
+use crate::resume::{Fingerprint, RunClock, RunFile};
+use czid_core::{Budget, CzError, Result};
+use czid_optimizers::checkpoint::{read_checkpoint, CheckpointWriter};
+use czid_optimizers::observers::Observers;
 use czid_optimizers::registry::{method_from_config, Method};
+use serde::{Deserialize, Serialize};
 
 /// What to compare.
 #[derive(Clone, Debug)]
@@ -26,6 +38,12 @@ pub struct CompareOptions {
     pub target: f64,
     /// Where the runs' batches go (default: this process's threads), e.g. MPI ranks.
     pub spread: Option<crate::identify::Spread>,
+    /// Keep the runs an interrupted comparison in the same folder finished, and continue the one
+    /// it was in.
+    pub resume: bool,
+    /// Abort the process, as a kill would, once the runs of this call have done this many
+    /// evaluations (for tests of interruption and resume).
+    pub abort_after: Option<usize>,
 }
 
 /// One run's outcome.
@@ -65,40 +83,152 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
         }
     }
     let mut runs = Vec::new();
+    let mut spent = 0usize;
     for name in &opts.optimizers {
         let (kind, settings) = problem.file.optimizer_named(name);
         for seed in 1..=opts.seeds {
-            let spread = opts.spread.as_ref().map(|s| s.0.as_ref());
-            let run = optimize(&id, &kind, &settings, seed, &budget, None, spread, &mut NoObserver)?;
-            let h = &run.result.history;
-            let at = |n: usize| h.iter().take_while(|(e, _)| *e <= n).last().map_or(f64::NAN, |(_, v)| *v);
-            let curve = grid.iter().map(|&n| at(n)).collect();
-            let evaluations_to_target = h.iter().find(|(_, v)| *v <= opts.target).map(|(e, _)| *e);
+            let folder = OutputDir::create(&out.file(&format!("runs/{}-seed{seed}", slug(name))), true, true)?;
+            let fingerprint = Fingerprint::of(&id, &problem.experiments, name, &settings, seed, budget.evaluations)?;
+            let (finished, kept) = match kept_run(&folder, &fingerprint, opts.resume)? {
+                Some(f) => (f, true),
+                None => {
+                    let abort = opts.abort_after.map(|n| n.saturating_sub(spent));
+                    let f = run_one(&id, &kind, &settings, seed, &budget, fingerprint, &folder, opts, abort)?;
+                    spent += f.evaluations;
+                    (f, false)
+                }
+            };
             eprintln!(
-                "{name:>20} seed {seed:>3}: f = {:.4e} in {} evaluations, {:.2} s",
-                run.result.best.value, run.result.evaluations, run.wall_seconds
+                "{name:>20} seed {seed:>3}: f = {:.4e} in {} evaluations, {:.2} s{}",
+                finished.best,
+                finished.evaluations,
+                finished.wall_seconds,
+                if kept { " (finished before the resume)" } else { "" }
             );
-            runs.push(RunSummary {
-                optimizer: name.clone(),
-                seed,
-                best: run.result.best.value,
-                evaluations_to_target,
-                evaluations: run.result.evaluations,
-                wall_seconds: run.wall_seconds,
-                x: id.space().from_unit(&run.result.best_x),
-                curve,
-            });
+            runs.push(finished.summary(name, seed, &grid, opts.target));
+            write_tables(&id, &runs, &grid, out)?;
         }
     }
-    write_outputs(&id, &runs, &grid, opts, out)?;
+    write_plots(&runs, &grid, opts, out)?;
     Ok(runs)
 }
 
-fn write_outputs(
+/// What a finished run leaves in its folder (`finished.json`): enough to rebuild its rows for any
+/// target and grid.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct FinishedRun {
+    /// The run it is (a resume with another problem, budget or settings does not keep it).
+    fingerprint: Fingerprint,
+    best: f64,
+    evaluations: usize,
+    /// Wall time over every part of the run (s).
+    wall_seconds: f64,
+    /// Identified physical values.
+    x: Vec<f64>,
+    /// Best-so-far after each iteration: (evaluations, best objective).
+    history: Vec<(usize, f64)>,
+}
+
+impl FinishedRun {
+    const NAME: &'static str = "finished.json";
+
+    fn summary(&self, optimizer: &str, seed: u64, grid: &[usize], target: f64) -> RunSummary {
+        let h = &self.history;
+        let at = |n: usize| h.iter().take_while(|(e, _)| *e <= n).last().map_or(f64::NAN, |(_, v)| *v);
+        RunSummary {
+            optimizer: optimizer.to_string(),
+            seed,
+            best: self.best,
+            evaluations_to_target: h.iter().find(|(_, v)| *v <= target).map(|(e, _)| *e),
+            evaluations: self.evaluations,
+            wall_seconds: self.wall_seconds,
+            x: self.x.clone(),
+            curve: grid.iter().map(|&n| at(n)).collect(),
+        }
+    }
+}
+
+/// The run finished in `folder` by an earlier call, when resuming; refused when it is another run.
+fn kept_run(folder: &OutputDir, fingerprint: &Fingerprint, resume: bool) -> Result<Option<FinishedRun>> {
+    let path = folder.file(FinishedRun::NAME);
+    if !resume || !path.exists() {
+        return Ok(None);
+    }
+    let shown = path.display().to_string();
+    let text =
+        std::fs::read_to_string(&path).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
+    let done: FinishedRun = serde_json::from_str(&text)
+        .map_err(|e| CzError::data(shown, format!("not a finished run of `czid compare`: {e}")))?;
+    let differences = fingerprint.differences(&done.fingerprint);
+    if !differences.is_empty() {
+        return Err(CzError::config(
+            "--resume",
+            format!(
+                "the run finished in {} is not this comparison's: {}. Give the same problem, optimizers \
+                 and budget to continue it, or start afresh with --force",
+                folder.path().display(),
+                differences.join("; ")
+            ),
+        ));
+    }
+    Ok(Some(done))
+}
+
+/// Runs one optimizer and seed in `folder`, continuing what an interrupted call left there when
+/// resuming, and writes `finished.json`.
+#[allow(clippy::too_many_arguments)]
+fn run_one(
+    id: &crate::identification::Identification,
+    kind: &str,
+    settings: &toml::Value,
+    seed: u64,
+    budget: &Budget,
+    fingerprint: Fingerprint,
+    folder: &OutputDir,
+    opts: &CompareOptions,
+    abort: Option<usize>,
+) -> Result<FinishedRun> {
+    let method = method_from_config(kind, settings)?;
+    let local = matches!(method, Method::Local(_));
+    // A run interrupted before its first checkpoint (or journal entry) starts again from scratch.
+    let started = opts.resume && folder.file(RunFile::NAME).exists();
+    let earlier = if started { Some(RunFile::for_resume(folder, &fingerprint)?) } else { None };
+    let checkpoint = folder.file("checkpoint.json");
+    let journal = folder.file("evaluations.jsonl");
+    let state = if started && !local && checkpoint.exists() { Some(read_checkpoint(&checkpoint)?) } else { None };
+    let replay = started && local && journal.exists();
+    let mut clock = RunClock::start(folder, fingerprint.clone(), earlier)?;
+    let mut writer = CheckpointWriter::new(&checkpoint, 1)?;
+    let mut abort = AbortAfter(abort);
+    let run = {
+        let mut observers = Observers(vec![&mut writer, &mut clock, &mut abort]);
+        let spread = opts.spread.as_ref().map(|s| s.0.as_ref());
+        let journal = local.then_some((journal.as_path(), replay));
+        optimize_with(id, &method, seed, budget, state.as_deref(), journal, spread, &mut observers)?
+    };
+    let finished = FinishedRun {
+        fingerprint,
+        best: run.result.best.value,
+        evaluations: run.result.evaluations,
+        wall_seconds: clock.finish()?,
+        x: id.space().from_unit(&run.result.best_x),
+        history: run.result.history,
+    };
+    let json = serde_json::to_string_pretty(&finished).map_err(|e| CzError::config("finished.json", e.to_string()))?;
+    folder.write(FinishedRun::NAME, &json)?;
+    Ok(finished)
+}
+
+/// A folder name for an optimizer's label.
+fn slug(label: &str) -> String {
+    label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+}
+
+/// `summary.csv` and `convergence.csv` of the runs so far.
+fn write_tables(
     id: &crate::identification::Identification,
     runs: &[RunSummary],
     grid: &[usize],
-    opts: &CompareOptions,
     out: &OutputDir,
 ) -> Result<()> {
     let mut text = String::from("optimizer,seed,best_objective,evaluations_to_target,evaluations,wall_seconds");
@@ -128,8 +258,11 @@ fn write_outputs(
         }
         conv.push('\n');
     }
-    out.write("convergence.csv", &conv)?;
+    out.write("convergence.csv", &conv).map(|_| ())
+}
 
+/// The convergence and final-objective plots.
+fn write_plots(runs: &[RunSummary], grid: &[usize], opts: &CompareOptions, out: &OutputDir) -> Result<()> {
     let xs: Vec<f64> = grid.iter().map(|&n| n as f64).collect();
     let mut fig = Figure::new("convergence (median, quartiles over seeds)", "evaluations", "best objective f").log_y();
     let mut finals =

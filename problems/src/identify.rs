@@ -139,7 +139,7 @@ impl Problem for Timed<'_> {
 }
 
 /// Aborts the process once `.0` evaluations are done, leaving files as a kill would.
-struct AbortAfter(Option<usize>);
+pub(crate) struct AbortAfter(pub(crate) Option<usize>);
 
 impl Observer for AbortAfter {
     fn observe(&mut self, p: &Progress<'_>) -> bool {
@@ -196,7 +196,7 @@ pub fn optimize(
 /// (at `path`: recorded, and replayed when it already holds them), and every batch through
 /// `spread` when given.
 #[allow(clippy::too_many_arguments)]
-fn optimize_with(
+pub(crate) fn optimize_with(
     id: &Identification,
     method: &Method,
     seed: u64,

@@ -250,6 +250,8 @@ fn compare_runs_every_optimizer_and_seed_and_writes_summary() {
         budget: None,
         target: 1e-3,
         spread: None,
+        resume: false,
+        abort_after: None,
     };
     let runs = compare(&p, &opts, &out).unwrap();
     assert_eq!(runs.len(), 4);
