@@ -247,6 +247,7 @@ fn main() -> ExitCode {
                 spread: cluster.spread(),
                 resume,
                 abort_after: abort_after_evaluations,
+                progress: true,
             };
             let outcome = run_compare(&problem, &set.sets, &out, &opts);
             cluster.finish("evaluations");

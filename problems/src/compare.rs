@@ -20,7 +20,7 @@ use crate::problem_file::LoadedProblem;
 use crate::resume::{Fingerprint, RunClock, RunFile};
 use czid_core::{Budget, CzError, Result};
 use czid_optimizers::checkpoint::{read_checkpoint, CheckpointWriter};
-use czid_optimizers::observers::Observers;
+use czid_optimizers::observers::{Observers, ProgressBar};
 use czid_optimizers::registry::{method_from_config, Method};
 use serde::{Deserialize, Serialize};
 
@@ -44,6 +44,8 @@ pub struct CompareOptions {
     /// Abort the process, as a kill would, once the runs of this call have done this many
     /// evaluations (for tests of interruption and resume).
     pub abort_after: Option<usize>,
+    /// Show each run's progress (a bar on a terminal, a line every tenth of the budget in a log).
+    pub progress: bool,
 }
 
 /// One run's outcome.
@@ -92,6 +94,9 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
             let (finished, kept) = match kept_run(&folder, &fingerprint, opts.resume)? {
                 Some(f) => (f, true),
                 None => {
+                    if opts.progress {
+                        eprintln!("{name:>20} seed {seed:>3}: running ({} evaluations)", budget.evaluations);
+                    }
                     let abort = opts.abort_after.map(|n| n.saturating_sub(spent));
                     let f = run_one(&id, &kind, &settings, seed, &budget, fingerprint, &folder, opts, abort)?;
                     spent += f.evaluations;
@@ -200,12 +205,15 @@ fn run_one(
     let mut clock = RunClock::start(folder, fingerprint.clone(), earlier)?;
     let mut writer = CheckpointWriter::new(&checkpoint, 1)?;
     let mut abort = AbortAfter(abort);
+    let n = budget.evaluations;
+    let mut bar = if opts.progress { ProgressBar::new(n) } else { ProgressBar::hidden(n) };
     let run = {
-        let mut observers = Observers(vec![&mut writer, &mut clock, &mut abort]);
+        let mut observers = Observers(vec![&mut writer, &mut clock, &mut abort, &mut bar]);
         let spread = opts.spread.as_ref().map(|s| s.0.as_ref());
         let journal = local.then_some((journal.as_path(), replay));
         optimize_with(id, &method, seed, budget, state.as_deref(), journal, spread, &mut observers)?
     };
+    bar.finish();
     let finished = FinishedRun {
         fingerprint,
         best: run.result.best.value,

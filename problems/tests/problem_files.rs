@@ -252,6 +252,7 @@ fn compare_runs_every_optimizer_and_seed_and_writes_summary() {
         spread: None,
         resume: false,
         abort_after: None,
+        progress: false,
     };
     let runs = compare(&p, &opts, &out).unwrap();
     assert_eq!(runs.len(), 4);
