@@ -145,6 +145,11 @@ fn compare(out: &Path, budget: &str, extra: &[&str]) -> Output {
 #[test]
 fn an_interrupted_comparison_resumes_to_the_uninterrupted_one() {
     let whole = scratch("compare-whole");
+    // Nothing to resume yet: said, and nothing run.
+    let early = compare(&whole, "200", &["--resume"]);
+    let err = String::from_utf8_lossy(&early.stderr).into_owned();
+    assert!(!early.status.success() && err.contains("nothing to resume"), "{err}");
+    assert!(!whole.join("summary.csv").exists());
     assert!(compare(&whole, "200", &[]).status.success());
     // Killed in MIGA's second seed: the first run is kept, the second continues from its
     // checkpoint, the other two run. (How local methods replay their journal is checked on

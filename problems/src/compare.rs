@@ -74,6 +74,13 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
     if opts.optimizers.is_empty() || opts.seeds == 0 {
         return Err(CzError::config("compare", "give at least one optimizer and one seed"));
     }
+    let runs_folder = out.file("runs");
+    if opts.resume && !runs_folder.is_dir() {
+        return Err(CzError::Io {
+            path: runs_folder.display().to_string(),
+            message: "no runs of a comparison here: nothing to resume (run without --resume to start)".into(),
+        });
+    }
     let id = problem.identification()?;
     let budget = Budget { evaluations: opts.budget.unwrap_or(problem.file.optimizer.budget), target: None };
     let grid: Vec<usize> = (1..=50).map(|k| (budget.evaluations * k).div_ceil(50)).collect();
