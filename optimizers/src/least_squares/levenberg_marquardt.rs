@@ -524,16 +524,29 @@ mod tests {
         // Residuals in noise units can be 10⁴ times those of the same fit normalised by the data:
         // the points evaluated must be the same. (With the damping started at τ max diag(JᵀJ),
         // the fit in the larger units took first steps 10⁸ times shorter.)
+        // The points are recorded in the order the method asks for them (a batch evaluated in
+        // parallel would record them in the order its threads finish).
+        struct Recorded {
+            scale: f64,
+            seen: std::cell::RefCell<Vec<Vec<f64>>>,
+        }
+        impl ResidualSource for Recorded {
+            type Error = ();
+            fn residuals(&self, points: &[Vec<f64>]) -> Result<Vec<Result<Vec<f64>, ()>>, ()> {
+                self.seen.borrow_mut().extend(points.iter().cloned());
+                let s = self.scale;
+                let r = |z: &Vec<f64>| {
+                    let (x, y) = (z[0], z[1]);
+                    Ok(vec![s * 10.0 * (y - x * x), s * (1.0 - x), s * 0.1 * (x + y - 1.5)])
+                };
+                Ok(points.iter().map(r).collect())
+            }
+        }
         let points = |scale: f64| {
-            let seen = std::sync::Mutex::new(Vec::new());
-            let f = Parallel(|z: &[f64]| -> Result<Vec<f64>, ()> {
-                seen.lock().unwrap().push(z.to_vec());
-                let (x, y) = (z[0], z[1]);
-                Ok(vec![scale * 10.0 * (y - x * x), scale * (1.0 - x), scale * 0.1 * (x + y - 1.5)])
-            });
+            let f = Recorded { scale, seen: Default::default() };
             let res = minimize(&f, &[0.05, 0.9], &boxed(vec![]), None).unwrap();
             assert!(res.evaluations > 20, "{}", res.evaluations);
-            seen.into_inner().unwrap()
+            f.seen.into_inner()
         };
         let (small, large) = (points(1.0), points(1e4));
         // The first thirty (near the optimum, rounding in the differences tells the two apart).
