@@ -147,7 +147,7 @@ fn an_interrupted_comparison_resumes_to_the_uninterrupted_one() {
     assert!(!whole.join("summary.csv").exists());
     assert!(compare(&whole, "200", &[]).status.success());
     // Killed in MIGA's second seed: the first run is kept, the second continues from its
-    // checkpoint, the other two run. (How local methods replay their journal is checked on
+    // checkpoint, Nelder–Mead (one run for both seeds) runs. (How local methods replay their journal is checked on
     // identifications above.)
     let cut = scratch("compare-cut");
     let killed = compare(&cut, "200", &["--abort-after-evaluations", "300"]);

@@ -1,5 +1,8 @@
 //! `compare`: several optimizers × seeds on one problem at equal evaluation budgets.
 //!
+//! A local method (Levenberg–Marquardt, Nelder–Mead, …) draws no random numbers and runs once:
+//! its other seeds would repeat that run.
+//!
 //! Writes `summary.csv` (one row per run: best objective, evaluations to reach the target, wall
 //! time, identified values), `convergence.csv` (best-so-far per run on a common evaluation grid),
 //! and plots: convergence (median and quartile band per optimizer) and final objective per
@@ -95,7 +98,13 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
     let mut spent = 0usize;
     for name in &opts.optimizers {
         let (kind, settings) = problem.file.optimizer_named(name);
-        for seed in 1..=opts.seeds {
+        // A local method draws no random numbers: every seed would repeat the same run (hours
+        // on a slow model), so it runs once and stands for all of them.
+        let seeds = if matches!(method_from_config(&kind, &settings)?, Method::Local(_)) { 1 } else { opts.seeds };
+        if seeds < opts.seeds {
+            eprintln!("{name:>20}: draws no random numbers, so one run stands for every seed");
+        }
+        for seed in 1..=seeds {
             let folder = OutputDir::create(&out.file(&format!("runs/{}-seed{seed}", slug(name))), true, true)?;
             let fingerprint = Fingerprint::of(&id, &problem.experiments, name, &settings, seed, budget.evaluations)?;
             let (finished, kept) = match kept_run(&folder, &fingerprint, opts.resume)? {
