@@ -412,7 +412,8 @@ fn run_synthesize(truth: &Path, out: &Path, force: bool) -> Result<(), CzError> 
 fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &CompareOptions) -> Result<(), CzError> {
     let problem = read_problem(problem, sets)?;
     let dir = OutputDir::create(&out.out, out.force, opts.resume)?;
-    let runs = compare(&problem, opts, &dir)?;
+    let comparison = compare(&problem, opts, &dir)?;
+    let runs = &comparison.runs;
     println!("{:<20} {:>6} {:>12} {:>12} {:>10}", "optimizer", "runs", "median f", "success", "median s");
     for name in &opts.optimizers {
         let mine: Vec<_> = runs.iter().filter(|r| &r.optimizer == name).collect();
@@ -429,6 +430,17 @@ fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &
             mine.len(),
             t[t.len() / 2]
         );
+    }
+    if let Some(e) = &comparison.equivalent {
+        println!(
+            "{} of {} runs end inside the 95 % confidence region of the best fit (f ≤ {:.4e}); their values span:",
+            e.inside.len(),
+            runs.len(),
+            e.threshold
+        );
+        for (p, (lo, hi)) in problem.identification()?.space().parameters().iter().zip(&e.ranges) {
+            println!("  {:<28} {lo:>12.5e} … {hi:<12.5e} {}", p.path, p.unit);
+        }
     }
     println!("summary, convergence and plots in {}", dir.path().display());
     Ok(())

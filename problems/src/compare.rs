@@ -3,6 +3,11 @@
 //! A local method (Levenberg–Marquardt, Nelder–Mead, …) draws no random numbers and runs once:
 //! its other seeds would repeat that run.
 //!
+//! Runs that end in different minima can fit equally well: the column `in_95_region` of
+//! `summary.csv` marks the runs inside the 95 % confidence region of the best one
+//! ([`crate::confidence_region`]), and [`Comparison::equivalent`] gives the spread of each
+//! parameter over them, which the standard errors at one run's end point cannot show.
+//!
 //! Writes `summary.csv` (one row per run: best objective, evaluations to reach the target, wall
 //! time, identified values), `convergence.csv` (best-so-far per run on a common evaluation grid),
 //! and plots: convergence (median and quartile band per optimizer) and final objective per
@@ -16,6 +21,7 @@
 //! interrupted one where it stopped and runs the rest: the outputs are those of the uninterrupted
 //! comparison, wall times apart.
 
+use crate::confidence_region::{equivalent_fits, EquivalentFits};
 use crate::identify::{optimize_with, AbortAfter};
 use crate::output::OutputDir;
 use crate::plot::{Figure, Series};
@@ -72,8 +78,18 @@ pub struct RunSummary {
     pub curve: Vec<f64>,
 }
 
+/// What a comparison found.
+#[derive(Clone, Debug)]
+pub struct Comparison {
+    /// Every run, in the order they ran.
+    pub runs: Vec<RunSummary>,
+    /// The runs inside the 95 % confidence region of the best one and each parameter's range over
+    /// them (`None` when the best run's residuals could not be counted: its model failed there).
+    pub equivalent: Option<EquivalentFits>,
+}
+
 /// Runs the comparison and writes its outputs into `out`.
-pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) -> Result<Vec<RunSummary>> {
+pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) -> Result<Comparison> {
     if opts.optimizers.is_empty() || opts.seeds == 0 {
         return Err(CzError::config("compare", "give at least one optimizer and one seed"));
     }
@@ -127,11 +143,23 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
                 if kept { " (finished before the resume)" } else { "" }
             );
             runs.push(finished.summary(name, seed, &grid, opts.target));
-            write_tables(&id, &runs, &grid, out)?;
+            write_tables(&id, &runs, &grid, None, out)?;
         }
     }
+    let equivalent = equivalent_runs(&id, &runs);
+    write_tables(&id, &runs, &grid, equivalent.as_ref(), out)?;
     write_plots(&runs, &grid, opts, out)?;
-    Ok(runs)
+    Ok(Comparison { runs, equivalent })
+}
+
+/// The runs inside the 95 % region of the best one; the number of residuals comes from a run of
+/// the model at the best run's values.
+fn equivalent_runs(id: &crate::identification::Identification, runs: &[RunSummary]) -> Option<EquivalentFits> {
+    let best = runs.iter().filter(|r| r.best.is_finite()).min_by(|a, b| a.best.total_cmp(&b.best))?;
+    let n = id.simulate(&best.x).ok()?.evaluation.residuals.len();
+    let f: Vec<f64> = runs.iter().map(|r| r.best).collect();
+    let x: Vec<Vec<f64>> = runs.iter().map(|r| r.x.clone()).collect();
+    equivalent_fits(&f, &x, n)
 }
 
 /// What a finished run leaves in its folder (`finished.json`): enough to rebuild its rows for any
@@ -248,21 +276,28 @@ fn slug(label: &str) -> String {
     label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
 }
 
-/// `summary.csv` and `convergence.csv` of the runs so far.
+/// `summary.csv` and `convergence.csv` of the runs so far (`in_95_region` is filled once every run
+/// has ended).
 fn write_tables(
     id: &crate::identification::Identification,
     runs: &[RunSummary],
     grid: &[usize],
+    region: Option<&EquivalentFits>,
     out: &OutputDir,
 ) -> Result<()> {
-    let mut text = String::from("optimizer,seed,best_objective,evaluations_to_target,evaluations,wall_seconds");
+    let mut text =
+        String::from("optimizer,seed,best_objective,evaluations_to_target,evaluations,wall_seconds,in_95_region");
     for p in id.space().parameters() {
         text.push_str(&format!(",{} ({})", p.path, p.unit));
     }
     text.push('\n');
-    for r in runs {
+    for (k, r) in runs.iter().enumerate() {
         let ett = r.evaluations_to_target.map_or(String::new(), |e| e.to_string());
-        text.push_str(&format!("{},{},{},{},{},{}", r.optimizer, r.seed, r.best, ett, r.evaluations, r.wall_seconds));
+        let inside = region.map_or("", |e| if e.inside.contains(&k) { "yes" } else { "no" });
+        text.push_str(&format!(
+            "{},{},{},{},{},{},{inside}",
+            r.optimizer, r.seed, r.best, ett, r.evaluations, r.wall_seconds
+        ));
         for v in &r.x {
             text.push_str(&format!(",{v}"));
         }

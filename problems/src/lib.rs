@@ -17,6 +17,7 @@
 //! * [`synthetic`]: synthetic tests with documented noise, for studies with a known truth.
 
 pub mod compare;
+pub mod confidence_region;
 pub mod data;
 pub mod diagnose;
 pub mod event;

@@ -254,13 +254,22 @@ fn compare_runs_every_seed_of_a_global_method_once_a_local_one_and_writes_summar
         abort_after: None,
         progress: false,
     };
-    let runs = compare(&p, &opts, &out).unwrap();
+    let comparison = compare(&p, &opts, &out).unwrap();
+    let runs = &comparison.runs;
     // Two MIGA seeds; Nelder–Mead draws no random numbers and runs once.
     let rows: Vec<(&str, u64)> = runs.iter().map(|r| (r.optimizer.as_str(), r.seed)).collect();
     assert_eq!(rows, [("miga", 1), ("miga", 2), ("nelder-mead", 1)]);
     assert!(runs.iter().all(|r| r.evaluations <= 200));
     let summary = std::fs::read_to_string(out.file("summary.csv")).unwrap();
     assert_eq!(summary.lines().count(), 4, "{summary}");
+    // The best run is inside its own 95 % region, and the table marks every run by its objective.
+    let e = comparison.equivalent.as_ref().expect("the region around the best run");
+    let best = (0..runs.len()).min_by(|&a, &b| runs[a].best.total_cmp(&runs[b].best)).unwrap();
+    assert!(e.inside.contains(&best) && e.threshold > runs[best].best);
+    for (k, line) in summary.lines().skip(1).enumerate() {
+        let inside = line.split(',').nth(6).unwrap();
+        assert_eq!(inside == "yes", runs[k].best <= e.threshold, "{line}");
+    }
     for f in ["convergence.csv", "convergence.png", "final_objective.png"] {
         assert!(out.file(f).exists(), "{f} missing");
     }

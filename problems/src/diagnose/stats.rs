@@ -63,7 +63,8 @@ pub fn chi2_survival(x: f64, k: f64) -> f64 {
     gamma_q(0.5 * k, 0.5 * x)
 }
 
-fn ln_gamma(x: f64) -> f64 {
+/// `ln Γ(x)` for `x > 0`.
+pub(crate) fn ln_gamma(x: f64) -> f64 {
     // Lanczos approximation (g = 7, n = 9), relative error below 1e-15 for x > 0.
     const C: [f64; 9] = [
         0.999_999_999_999_809_9,
