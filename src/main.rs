@@ -431,7 +431,10 @@ fn run_compare(problem: &Path, sets: &[(String, String)], out: &OutArgs, opts: &
             t[t.len() / 2]
         );
     }
-    if let Some(e) = &comparison.equivalent {
+    if let Err(why) = &comparison.equivalent {
+        println!("no 95 % confidence region of the best fit ({why}): the column in_95_region is left empty");
+    }
+    if let Ok(e) = &comparison.equivalent {
         println!(
             "{} of {} runs end inside the 95 % confidence region of the best fit (f ≤ {:.4e}); their values span:",
             e.inside.len(),

@@ -84,8 +84,9 @@ pub struct Comparison {
     /// Every run, in the order they ran.
     pub runs: Vec<RunSummary>,
     /// The runs inside the 95 % confidence region of the best one and each parameter's range over
-    /// them (`None` when the best run's residuals could not be counted: its model failed there).
-    pub equivalent: Option<EquivalentFits>,
+    /// them, or why there is no region (no run ended with a finite value, the model failed at the
+    /// best run's values, or there are no more residuals than parameters).
+    pub equivalent: std::result::Result<EquivalentFits, String>,
 }
 
 /// Runs the comparison and writes its outputs into `out`.
@@ -147,19 +148,31 @@ pub fn compare(problem: &LoadedProblem, opts: &CompareOptions, out: &OutputDir) 
         }
     }
     let equivalent = equivalent_runs(&id, &runs);
-    write_tables(&id, &runs, &grid, equivalent.as_ref(), out)?;
+    write_tables(&id, &runs, &grid, equivalent.as_ref().ok(), out)?;
     write_plots(&runs, &grid, opts, out)?;
     Ok(Comparison { runs, equivalent })
 }
 
-/// The runs inside the 95 % region of the best one; the number of residuals comes from a run of
-/// the model at the best run's values.
-fn equivalent_runs(id: &crate::identification::Identification, runs: &[RunSummary]) -> Option<EquivalentFits> {
-    let best = runs.iter().filter(|r| r.best.is_finite()).min_by(|a, b| a.best.total_cmp(&b.best))?;
-    let n = id.simulate(&best.x).ok()?.evaluation.residuals.len();
+/// The runs inside the 95 % region of the best one, or why there is none; the number of residuals
+/// comes from a run of the model at the best run's values.
+fn equivalent_runs(
+    id: &crate::identification::Identification,
+    runs: &[RunSummary],
+) -> std::result::Result<EquivalentFits, String> {
+    let best = runs
+        .iter()
+        .filter(|r| r.best.is_finite())
+        .min_by(|a, b| a.best.total_cmp(&b.best))
+        .ok_or("no run ended with a finite objective value")?;
+    let n = match id.simulate(&best.x) {
+        Ok(sim) => sim.evaluation.residuals.len(),
+        Err(e) => return Err(format!("the model failed at the best run's values ({e})")),
+    };
     let f: Vec<f64> = runs.iter().map(|r| r.best).collect();
     let x: Vec<Vec<f64>> = runs.iter().map(|r| r.x.clone()).collect();
+    let p = x.first().map_or(0, Vec::len);
     equivalent_fits(&f, &x, n)
+        .ok_or_else(|| format!("{n} residuals for {p} parameters: the region needs more residuals than parameters"))
 }
 
 /// What a finished run leaves in its folder (`finished.json`): enough to rebuild its rows for any
