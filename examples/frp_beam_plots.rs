@@ -24,6 +24,20 @@ struct Config {
     model: FrpBeam,
 }
 
+/// The model file's law and beam: its `type` keys name them (`st_czm`, `frp_beam`), the rest are
+/// their fields.
+fn read_config(text: &str) -> Result<Config, AnyError> {
+    let mut table: toml::Table = toml::from_str(text)?;
+    for (section, kind) in [("law", "st_czm"), ("model", "frp_beam")] {
+        let t = table.get_mut(section).and_then(|v| v.as_table_mut()).ok_or(format!("no [{section}] table"))?;
+        match t.remove("type") {
+            Some(toml::Value::String(k)) if k == kind => {}
+            other => return Err(format!("[{section}] must have type = \"{kind}\" (found {other:?})").into()),
+        }
+    }
+    Ok(table.try_into()?)
+}
+
 fn col(rec: &Record, name: &str) -> Vec<f64> {
     rec.column(name).map(|c| c.to_vec()).unwrap_or_default()
 }
@@ -62,7 +76,7 @@ fn main() -> Result<(), AnyError> {
     let out = args.next().map(PathBuf::from).unwrap_or_else(|| "target/examples-output/frp_beam".into());
     std::fs::create_dir_all(&out)?;
     let text = std::fs::read_to_string(&config).map_err(|e| format!("{}: {e}", config.display()))?;
-    let cfg: Config = toml::from_str(&text).map_err(|e| format!("{}: {e}", config.display()))?;
+    let cfg = read_config(&text).map_err(|e| format!("{}: {e}", config.display()))?;
     let beam = cfg.model;
     let started = std::time::Instant::now();
     let run = beam.run(&cfg.law, true).map_err(|f| format!("the run stopped: {}", f.error))?;
