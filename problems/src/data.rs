@@ -172,6 +172,24 @@ pub struct ExperimentSpec {
     /// branch (the toe, where the fixture seats). The shift is reported with the dropped rows.
     #[serde(default)]
     pub toe_compensation: Option<[f64; 2]>,
+    /// Standard deviation of the load readings (N; N·mm with `ordinate = "midspan_moment"`), if
+    /// known (a load cell's stated accuracy). `weights = "noise"` uses it; without it the noise is
+    /// estimated from the readings themselves.
+    #[serde(default)]
+    pub load_noise: Option<f64>,
+    /// Standard deviation of the crack or debonded-length readings (mm), if known; as `load_noise`.
+    #[serde(default)]
+    pub length_noise: Option<f64>,
+}
+
+/// The stated standard deviations of a test's readings (`load_noise`, `length_noise` of its data
+/// table), for weighting the objective by the noise.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReadingNoise {
+    /// Of the load (N, or N·mm for a moment).
+    pub load: Option<f64>,
+    /// Of the debonded length (mm).
+    pub debonded_length: Option<f64>,
 }
 
 /// Rows of a data file that reading left out, by reason.
@@ -227,6 +245,8 @@ pub struct Experiment {
     pub events: Vec<crate::event::MeasuredEvent>,
     /// What `load` holds (the load, or the mid-span moment in N·mm).
     pub ordinate: Ordinate,
+    /// The readings' stated noise, where the data table gives it.
+    pub noise: ReadingNoise,
 }
 
 impl ExperimentSpec {
@@ -234,6 +254,18 @@ impl ExperimentSpec {
     pub fn load(&self, base: &Path) -> Result<Experiment> {
         let path = base.join(&self.file);
         let shown = path.display().to_string();
+        for (key, v) in [("load_noise", self.load_noise), ("length_noise", self.length_noise)] {
+            if let Some(v) = v {
+                if !(v > 0.0 && v.is_finite()) {
+                    return Err(CzError::invalid(
+                        format!("data of {shown}"),
+                        key,
+                        v,
+                        "must be a positive standard deviation (N or mm); leave it out to estimate the noise from the readings",
+                    ));
+                }
+            }
+        }
         let text = std::fs::read_to_string(&path).map_err(|e| CzError::Io {
             path: shown.clone(),
             message: format!("{e} (paths in a problem file are relative to the problem file)"),
@@ -385,6 +417,7 @@ impl ExperimentSpec {
             dropped,
             events: Vec::new(),
             ordinate: self.ordinate,
+            noise: ReadingNoise { load: self.load_noise, debonded_length: self.length_noise },
         })
     }
 }
@@ -473,6 +506,8 @@ mod tests {
             drop_non_increasing: false,
             drop_non_finite: false,
             toe_compensation: None,
+            load_noise: None,
+            length_noise: None,
         }
     }
 

@@ -130,6 +130,10 @@ struct Fit {
     kinds: Vec<Term>,
     /// Factor on each term's weight (an event's `weight`; 1 for curves).
     factors: Vec<f64>,
+    /// Each term's stated noise: a curve's `load_noise` or `length_noise`, an event's
+    /// `uncertainty` (N or mm); `None` where none is given (a curve's is then estimated from its
+    /// readings).
+    uncertainties: Vec<Option<f64>>,
     /// Unit of each term.
     units: Vec<&'static str>,
 }
@@ -287,6 +291,8 @@ impl Identification {
                 }
             }
             let mut factors = vec![1.0; terms.len()];
+            let mut uncertainties: Vec<Option<f64>> =
+                kinds.iter().map(|k| if *k == Term::Load { e.noise.load } else { e.noise.debonded_length }).collect();
             for ev in &e.events {
                 // One reading; its abscissa is not used by an event response.
                 terms.push(ObjectiveTerm {
@@ -297,10 +303,11 @@ impl Identification {
                 });
                 kinds.push(Term::Event);
                 factors.push(ev.weight);
+                uncertainties.push(ev.uncertainty);
                 units.push(ev.unit());
             }
             let objective = CompositeObjective::new(terms)?;
-            fits.push(Fit { name: e.name.clone(), objective, kinds, factors, units });
+            fits.push(Fit { name: e.name.clone(), objective, kinds, factors, uncertainties, units });
         }
         // Fail early, with the path named, if a parameter does not exist in the setup.
         space.read(&setup)?;
@@ -349,6 +356,41 @@ impl Identification {
         let mut weights = balanced_weights(&all).into_iter();
         for (fit, parts) in self.fits.iter_mut().zip(parts) {
             let w: Vec<f64> = weights.by_ref().take(parts.len()).zip(&fit.factors).map(|(w, f)| w * f).collect();
+            fit.objective.set_weights(&w)?;
+        }
+        Ok(())
+    }
+
+    /// Weights every term by its data's noise, so that the objective is χ², the sum of the squared
+    /// residuals in units of the noise: `α_i = ||y_i||² / σ_i²` (the term is `||y − ŷ||² / ||y||²`),
+    /// with `σ_i` a curve's stated `load_noise` or `length_noise` (estimated from its own readings
+    /// where not given, [`czid_core::noise::estimate`]) and an event's stated `uncertainty` (times
+    /// the event's own `weight`). Unlike weights balanced at the initial guess, these do not depend on the guess, and
+    /// they let a precise test (a pull test's load cell) count for what it is worth beside a coarse
+    /// one (debonded lengths read with a ruler). An event without an `uncertainty` is an error.
+    pub fn noise_weights(&mut self) -> Result<()> {
+        for fit in &mut self.fits {
+            let mut w = Vec::with_capacity(fit.kinds.len());
+            for (((term, kind), factor), u) in
+                fit.objective.terms().iter().zip(&fit.kinds).zip(&fit.factors).zip(&fit.uncertainties)
+            {
+                let sigma = match (kind, u) {
+                    (_, Some(u)) => *u,
+                    (Term::Event, None) => return Err(CzError::config(
+                        format!("[objective] weights = \"noise\", event `{}`", term.name),
+                        "has no `uncertainty`: give the reading's standard uncertainty (N or mm), or use \"balanced\"",
+                    )),
+                    (k, _) => czid_core::noise::estimate(term.data.x(), term.data.y(), *k == Term::DebondedLength),
+                };
+                let norm = term.data.norm();
+                if !(sigma > 0.0 && sigma.is_finite()) {
+                    return Err(CzError::config(
+                        format!("[objective] weights = \"noise\", `{}`", term.name),
+                        format!("its noise ({sigma:e}) is not a positive number: use \"balanced\" or explicit weights"),
+                    ));
+                }
+                w.push(factor * (norm / sigma).powi(2));
+            }
             fit.objective.set_weights(&w)?;
         }
         Ok(())

@@ -74,7 +74,9 @@ pub struct ExperimentEntry {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum Weights {
-    /// `"balanced"`: equal contributions at the initial guess (the paper's choice).
+    /// `"balanced"`: equal contributions at the initial guess (the paper's choice); `"noise"`: each
+    /// term in units of its data's noise, so that the objective is χ²
+    /// ([`crate::identification::Identification::noise_weights`]).
     Named(String),
     /// Explicit α for the load, debonded-length and event terms.
     Explicit {
@@ -361,10 +363,13 @@ impl LoadedProblem {
         let mut id = Identification::new(setup, space, &self.experiments, self.file.objective.debonded_length)?;
         match &self.file.objective.weights {
             Weights::Named(n) if n == "balanced" => id.balance_weights()?,
+            Weights::Named(n) if n == "noise" => id.noise_weights()?,
             Weights::Named(n) => {
                 return Err(CzError::config(
                     format!("{shown}, [objective] weights"),
-                    format!("`{n}` is not a weighting; use \"balanced\" or {{ load = .., debonded_length = .. }}"),
+                    format!(
+                        "`{n}` is not a weighting; use \"balanced\", \"noise\" or {{ load = .., debonded_length = .. }}"
+                    ),
                 ))
             }
             Weights::Explicit { load, debonded_length, events } => {

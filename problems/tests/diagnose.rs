@@ -177,6 +177,7 @@ fn diagnose_made_by(bridging: f64, continuum: bool) -> czid_problems::diagnose::
         dropped: Default::default(),
         events: Vec::new(),
         ordinate: Default::default(),
+        noise: Default::default(),
     };
     let space = ParameterSpace::new(vec![
         Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),

@@ -247,6 +247,7 @@ fn experiment(s: &Synthetic) -> Experiment {
         dropped: Default::default(),
         events: Vec::new(),
         ordinate: Default::default(),
+        noise: Default::default(),
     }
 }
 

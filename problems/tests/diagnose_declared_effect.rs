@@ -128,6 +128,7 @@ fn a_planted_declared_effect_is_named_by_the_diagnosis() {
         dropped: Default::default(),
         events: Vec::new(),
         ordinate: Default::default(),
+        noise: Default::default(),
     };
     let space = ParameterSpace::new(vec![
         Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),

@@ -42,6 +42,7 @@ fn diagnose_made_with(mu: f64) -> czid_problems::diagnose::Diagnosis {
         dropped: Default::default(),
         events: Vec::new(),
         ordinate: Default::default(),
+        noise: Default::default(),
     };
     let space = ParameterSpace::new(vec![
         Parameter::new("law.strength_t", "MPa", 10.0, 150.0).log(),

@@ -355,6 +355,12 @@ fn csv_data_never_panics_and_what_is_accepted_is_sound() {
                 1 => Some([f64::NAN, 0.5]),
                 _ => None,
             },
+            load_noise: match rng.random_range(0..4) {
+                0 => Some(rng.random_range(-1.0..5.0)),
+                1 => Some(f64::NAN),
+                _ => None,
+            },
+            length_noise: None,
         };
         match spec.load(&dir) {
             Ok(e) => {

@@ -353,6 +353,7 @@ fn synthetic_experiment(
         dropped: Default::default(),
         events: Vec::new(),
         ordinate: Default::default(),
+        noise: Default::default(),
     })
 }
 
