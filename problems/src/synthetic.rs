@@ -40,6 +40,22 @@ impl Synthetic {
         }
         s
     }
+
+    /// The synthetic test as an experiment named `name`: its load and debonded-length curves,
+    /// nothing dropped, no events, no stated noise (set [`crate::data::Experiment::noise`] to give
+    /// the one it was made with).
+    pub fn experiment(&self, name: &str) -> Result<crate::data::Experiment> {
+        Ok(crate::data::Experiment {
+            name: name.into(),
+            load: czid_core::Curve::new(self.displacement.clone(), self.load.clone())?,
+            debonded_length: Some(czid_core::Curve::new(self.displacement.clone(), self.debonded_length.clone())?),
+            initial_crack: None,
+            dropped: Default::default(),
+            events: Vec::new(),
+            ordinate: Default::default(),
+            noise: Default::default(),
+        })
+    }
 }
 
 /// Samples `record` at `points` equally spaced displacements over (0, max] and adds noise.

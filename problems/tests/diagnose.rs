@@ -2,10 +2,9 @@
 //! values, a planted effect is found and a clean case is left alone, regimes split where a hand
 //! analysis of the curve puts them.
 
-use czid_core::{CohesiveLaw, Curve, ForwardModel, Parameter, ParameterSpace};
+use czid_core::{CohesiveLaw, ForwardModel, Parameter, ParameterSpace};
 use czid_models::dcb::Dcb;
 use czid_models::laws::Bilinear;
-use czid_problems::data::Experiment;
 use czid_problems::diagnose::regimes::{self, NAMES};
 use czid_problems::diagnose::run::{diagnose_subject, Subject};
 use czid_problems::diagnose::{CandidateEffect, Kind, Library, Options};
@@ -169,16 +168,7 @@ fn diagnose_made_by(bridging: f64, continuum: bool) -> czid_problems::diagnose::
         truth.models["dcb"].simulate(truth.law.as_ref()).unwrap()
     };
     let data = synthesize(&record, 80, Some(16.0), &Noise { load_sd: 0.4, length_sd: 0.3, seed: 11 }).unwrap();
-    let experiment = Experiment {
-        name: "dcb".into(),
-        load: Curve::new(data.displacement.clone(), data.load).unwrap(),
-        debonded_length: Some(Curve::new(data.displacement, data.debonded_length).unwrap()),
-        initial_crack: None,
-        dropped: Default::default(),
-        events: Vec::new(),
-        ordinate: Default::default(),
-        noise: Default::default(),
-    };
+    let experiment = data.experiment("dcb").unwrap();
     let space = ParameterSpace::new(vec![
         Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),
         Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),

@@ -9,11 +9,10 @@
 //! can absorb `Δ`; the debonded length cannot.
 
 use czid_core::{
-    columns, CohesiveLaw, Curve, EffectDeclaration, EffectKind, EffectScope, ForwardModel, Parameter, ParameterSpace,
-    Record, Sign, SimulationFailure, Typical,
+    columns, CohesiveLaw, EffectDeclaration, EffectKind, EffectScope, ForwardModel, Parameter, ParameterSpace, Record,
+    Sign, SimulationFailure, Typical,
 };
 use czid_models::laws::Bilinear;
-use czid_problems::data::Experiment;
 use czid_problems::diagnose::run::{diagnose_subject, Subject};
 use czid_problems::diagnose::{Library, Options};
 use czid_problems::identification::Setup;
@@ -120,16 +119,7 @@ fn a_planted_declared_effect_is_named_by_the_diagnosis() {
     let truth = setup(3.0);
     let record = truth.models["dcb"].simulate(truth.law.as_ref()).unwrap();
     let data = synthesize(&record, 200, None, &Noise { load_sd: 0.3, length_sd: 0.3, seed: 3 }).unwrap();
-    let experiment = Experiment {
-        name: "dcb".into(),
-        load: Curve::new(data.displacement.clone(), data.load).unwrap(),
-        debonded_length: Some(Curve::new(data.displacement, data.debonded_length).unwrap()),
-        initial_crack: None,
-        dropped: Default::default(),
-        events: Vec::new(),
-        ordinate: Default::default(),
-        noise: Default::default(),
-    };
+    let experiment = data.experiment("dcb").unwrap();
     let space = ParameterSpace::new(vec![
         Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),
         Parameter::new("models.*.modulus", "MPa", 10_000.0, 40_000.0),

@@ -6,7 +6,7 @@
 
 use std::collections::BTreeMap;
 
-use czid_core::{columns, CohesiveLaw, Curve, ForwardModel, Parameter, ParameterSpace};
+use czid_core::{columns, CohesiveLaw, ForwardModel, Parameter, ParameterSpace};
 use czid_models::dcb::Dcb;
 use czid_models::laws::Bilinear;
 use czid_problems::data::{Experiment, ReadingNoise};
@@ -41,16 +41,7 @@ fn identification(noise: ReadingNoise) -> (Identification, f64) {
         .zip(data.load.iter().zip(&data.debonded_length))
         .map(|(&d, (&p, &l))| ((p - load.at(d)) / LOAD_SD).powi(2) + ((l - length.at(d)) / LENGTH_SD).powi(2))
         .sum();
-    let experiment = Experiment {
-        name: "dcb".into(),
-        load: Curve::new(data.displacement.clone(), data.load).unwrap(),
-        debonded_length: Some(Curve::new(data.displacement, data.debonded_length).unwrap()),
-        initial_crack: None,
-        dropped: Default::default(),
-        events: Vec::new(),
-        ordinate: Default::default(),
-        noise,
-    };
+    let experiment = Experiment { noise, ..data.experiment("dcb").unwrap() };
     let space = ParameterSpace::new(vec![
         Parameter::new("law.strength_n", "MPa", 5.0, 80.0).log(),
         Parameter::new("law.g_ic", "N/mm", 0.2, 2.0),

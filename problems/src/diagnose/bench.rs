@@ -344,17 +344,7 @@ fn synthetic_experiment(
     end: f64,
     noise: &Noise,
 ) -> Result<Experiment> {
-    let data = synthesize(record, readings, Some(end), noise)?;
-    Ok(Experiment {
-        name: family.name().into(),
-        load: Curve::new(data.displacement.clone(), data.load)?,
-        debonded_length: Some(Curve::new(data.displacement, data.debonded_length)?),
-        initial_crack: None,
-        dropped: Default::default(),
-        events: Vec::new(),
-        ordinate: Default::default(),
-        noise: Default::default(),
-    })
+    synthesize(record, readings, Some(end), noise)?.experiment(family.name())
 }
 
 /// The experiment read by a displacement transducer of gain `1 + g`.
