@@ -365,9 +365,10 @@ impl Identification {
     /// residuals in units of the noise: `α_i = ||y_i||² / σ_i²` (the term is `||y − ŷ||² / ||y||²`),
     /// with `σ_i` a curve's stated `load_noise` or `length_noise` (estimated from its own readings
     /// where not given, [`czid_core::noise::estimate`]) and an event's stated `uncertainty` (times
-    /// the event's own `weight`). Unlike weights balanced at the initial guess, these do not depend on the guess, and
-    /// they let a precise test (a pull test's load cell) count for what it is worth beside a coarse
-    /// one (debonded lengths read with a ruler). An event without an `uncertainty` is an error.
+    /// the event's own `weight`). Unlike weights balanced at the initial guess, these do not depend
+    /// on the guess, and they let a precise test (a pull test's load cell) count for what it is
+    /// worth beside a coarse one (debonded lengths read with a ruler). An event without an
+    /// `uncertainty` is an error.
     pub fn noise_weights(&mut self) -> Result<()> {
         for fit in &mut self.fits {
             let mut w = Vec::with_capacity(fit.kinds.len());

@@ -239,16 +239,7 @@ fn the_regime_rule_is_the_one_each_experiment_s_model_declares() {
 }
 
 fn experiment(s: &Synthetic) -> Experiment {
-    Experiment {
-        name: "beam".into(),
-        load: Curve::new(s.displacement.clone(), s.load.clone()).unwrap(),
-        debonded_length: Some(Curve::new(s.displacement.clone(), s.debonded_length.clone()).unwrap()),
-        initial_crack: None,
-        dropped: Default::default(),
-        events: Vec::new(),
-        ordinate: Default::default(),
-        noise: Default::default(),
-    }
+    s.experiment("beam").unwrap()
 }
 
 fn beam_setup(beam: FrpBeam) -> Setup {
