@@ -370,3 +370,64 @@ fn a_problem_with_events_plots_them_test_beside_model() {
     std::fs::remove_dir_all(&out).ok();
     std::fs::remove_dir_all(&dcb).ok();
 }
+
+#[test]
+fn a_fit_is_profiled_and_its_interval_brackets_it() {
+    let (fit, prof) = (scratch("profile-fit"), scratch("profile"));
+    let coarse = ["--set", "models.dcb01.mesh.interface_element=0.5"];
+    let mut args = vec!["identify", "examples/hartlen-dcb/dcb01.toml", "--out", fit.to_str().unwrap()];
+    args.extend(coarse);
+    let r = czid(&args);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let from = fit.join("result.json");
+    let mut args = vec!["profile", "examples/hartlen-dcb/dcb01.toml", "--from", from.to_str().unwrap()];
+    args.extend(["--parameters", "law.g_ic", "--out", prof.to_str().unwrap()]);
+    args.extend(coarse);
+    let r = czid(&args);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(prof.join("profile.json")).unwrap()).unwrap();
+    let p = &report["profiles"][0];
+    assert_eq!(p["path"], "law.g_ic");
+    assert_eq!(p["unit"], "N/mm");
+    let best = p["best"].as_f64().unwrap();
+    let (lower, upper) = (&p["lower"], &p["upper"]);
+    assert_eq!((lower["kind"].as_str(), upper["kind"].as_str()), (Some("crossed"), Some("crossed")), "{p}");
+    assert!(lower["value"].as_f64().unwrap() < best && best < upper["value"].as_f64().unwrap(), "{p}");
+    // Every profile point is a refit with G_Ic held: none lies below the fit by more than the
+    // inner fits' tolerance, and the outermost ones stand above the fit.
+    let (f0, th) = (p["best_objective"].as_f64().unwrap(), p["threshold"].as_f64().unwrap());
+    let fs: Vec<f64> = p["points"].as_array().unwrap().iter().map(|q| q["objective"].as_f64().unwrap()).collect();
+    assert!(fs.iter().all(|f| *f >= f0 - 0.05 * (th - f0)), "{fs:?}");
+    assert!(fs[0] > f0 && fs[fs.len() - 1] > f0, "{fs:?}");
+    assert!(p["linearised"].as_array().is_some_and(|v| v.len() == 2));
+    assert!(prof.join("profile-law_g_ic.png").exists() && prof.join("profile.csv").exists());
+
+    // An unknown parameter is named with the problem's parameters; no steps is refused.
+    let r = czid(&[
+        "profile",
+        "examples/hartlen-dcb/dcb01.toml",
+        "--from",
+        from.to_str().unwrap(),
+        "--parameters",
+        "law.g_iic",
+        "--out",
+        "unused",
+    ]);
+    assert!(!r.status.success() && stderr(&r).contains("`law.g_iic` is not a parameter"), "{}", stderr(&r));
+    assert!(stderr(&r).contains("law.strength_n, law.g_ic"), "{}", stderr(&r));
+    let r = czid(&[
+        "profile",
+        "examples/hartlen-dcb/dcb01.toml",
+        "--from",
+        from.to_str().unwrap(),
+        "--max-steps",
+        "0",
+        "--out",
+        "unused",
+    ]);
+    assert!(!r.status.success() && stderr(&r).contains("--max-steps"), "{}", stderr(&r));
+    std::fs::remove_dir_all(&fit).ok();
+    std::fs::remove_dir_all(&prof).ok();
+    assert!(!Path::new("unused").exists());
+}

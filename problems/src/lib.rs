@@ -27,6 +27,7 @@ pub mod identification;
 pub mod identify;
 pub mod output;
 pub mod predict;
+pub mod profile;
 pub use czid_optimizers::plot;
 pub mod problem_file;
 pub mod resume;
