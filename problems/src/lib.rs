@@ -11,6 +11,7 @@
 //! * [`identifiability`]: standard errors, correlations and a verdict per identified parameter.
 //! * [`output`]: output folders that are never clobbered by accident, files written atomically.
 //! * [`plot`]: line plots (PNG/SVG) with a bundled font, written atomically (from czid-optimizers).
+//! * [`profile`]: profile-likelihood 95 % intervals of a fit's parameters (`czid profile`).
 //! * [`problem_file`]: the TOML problem file (law, experiments, parameters, objective, optimizer).
 //! * [`resume`]: what an identification keeps to continue after an interruption (fingerprint,
 //!   wall time, history).

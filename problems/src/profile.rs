@@ -29,7 +29,8 @@ use czid_core::{CzError, Result};
 use czid_optimizers::least_squares::{self, LmOptions, Parallel, ResidualSource};
 use serde::Serialize;
 
-/// How an interval ends on one side, in the parameter's physical unit.
+/// How an interval ends on one side (in the parameter's physical unit in a [`Profile`], in
+/// unit-cube coordinates in a [`UnitProfile`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case", tag = "kind", content = "value")]
 pub enum End {
@@ -149,29 +150,29 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
     // third of that way, so that a nearly quadratic profile crosses within a few steps.
     let first = se_u.filter(|s| s.is_finite() && *s > 0.0).map_or(0.02, |s| (0.7 * s).clamp(1e-4, 0.1));
     let mut points = vec![UnitPoint { value: u[j], objective: f_min, at: u.to_vec() }];
-    let mut ends = [UnitEnd::NotReached(u[j]); 2];
+    let mut ends = [End::NotReached(u[j]); 2];
     for (side, dir) in [-1.0f64, 1.0].into_iter().enumerate() {
         let mut prev = points[0].clone();
         let mut h = first;
-        ends[side] = UnitEnd::NotReached(u[j]);
+        ends[side] = End::NotReached(u[j]);
         for _ in 0..opts.max_steps {
             let v = (prev.value + dir * h).clamp(0.0, 1.0);
             if v == prev.value {
-                ends[side] = UnitEnd::AtBound(v);
+                ends[side] = End::AtBound(v);
                 break;
             }
             let next = fit_at(src, &prev.at, j, v, opts)?;
             points.push(next.clone());
             if next.objective > threshold {
                 let crossing = refine(src, &prev, &next, j, threshold, gap, opts, &mut points)?;
-                ends[side] = UnitEnd::Crossed(crossing);
+                ends[side] = End::Crossed(crossing);
                 break;
             }
             if v == 0.0 || v == 1.0 {
-                ends[side] = UnitEnd::AtBound(v);
+                ends[side] = End::AtBound(v);
                 break;
             }
-            ends[side] = UnitEnd::NotReached(v);
+            ends[side] = End::NotReached(v);
             // Aim each step at a quarter of the way to the threshold: a profile is near-quadratic
             // close to the fit, so a small rise allows a longer step.
             let rise = next.objective - prev.objective;
@@ -193,24 +194,6 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
     Ok(UnitProfile { lower: ends[0], upper: ends[1], points, better })
 }
 
-/// A side's end in unit-cube coordinates.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum UnitEnd {
-    /// See [`End::Crossed`].
-    Crossed(f64),
-    /// See [`End::AtBound`].
-    AtBound(f64),
-    /// See [`End::NotReached`].
-    NotReached(f64),
-}
-
-impl UnitEnd {
-    /// Whether the profile crossed the threshold on this side.
-    pub fn is_crossed_unit(self) -> bool {
-        matches!(self, UnitEnd::Crossed(_))
-    }
-}
-
 /// A point of a profile in unit-cube coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UnitPoint {
@@ -226,9 +209,9 @@ pub struct UnitPoint {
 #[derive(Clone, Debug, PartialEq)]
 pub struct UnitProfile {
     /// Lower side.
-    pub lower: UnitEnd,
+    pub lower: End,
     /// Upper side.
-    pub upper: UnitEnd,
+    pub upper: End,
     /// Points sorted by the profiled coordinate.
     pub points: Vec<UnitPoint>,
     /// A point below the fit's objective, if found.
@@ -332,10 +315,10 @@ pub fn profiles(
         });
         let up = profile_unit(&src, &u, j, f_min, threshold, se_u, opts)?;
         let phys = |v: f64| space.from_unit(&with(&u, j, v))[j];
-        let end = |e: UnitEnd| match e {
-            UnitEnd::Crossed(v) => End::Crossed(phys(v)),
-            UnitEnd::AtBound(v) => End::AtBound(phys(v)),
-            UnitEnd::NotReached(v) => End::NotReached(phys(v)),
+        let end = |e: End| match e {
+            End::Crossed(v) => End::Crossed(phys(v)),
+            End::AtBound(v) => End::AtBound(phys(v)),
+            End::NotReached(v) => End::NotReached(phys(v)),
         };
         let point = |q: &UnitPoint| ProfilePoint { value: phys(q.value), objective: q.objective, at: q.at.clone() };
         let profile = Profile {
@@ -546,7 +529,7 @@ mod tests {
             let se = (sigma2 * inv[(j, j)]).sqrt();
             let pr = profile_unit(&src, &u, j, f_min, th, Some(se), &tight()).unwrap();
             let half = 2.228139 * se;
-            let (UnitEnd::Crossed(lo), UnitEnd::Crossed(hi)) = (pr.lower, pr.upper) else {
+            let (End::Crossed(lo), End::Crossed(hi)) = (pr.lower, pr.upper) else {
                 panic!("parameter {j}: {:?} {:?}", pr.lower, pr.upper)
             };
             assert!((lo - (u[j] - half)).abs() < 1e-5 * half, "parameter {j}: lower {lo}, t interval {}", u[j] - half);
@@ -603,7 +586,7 @@ mod tests {
                 valley_profile(q.value)
             );
         }
-        let (UnitEnd::Crossed(lo), UnitEnd::Crossed(hi)) = (pr.lower, pr.upper) else {
+        let (End::Crossed(lo), End::Crossed(hi)) = (pr.lower, pr.upper) else {
             panic!("{:?} {:?}", pr.lower, pr.upper)
         };
         assert!((valley_profile(lo) - th).abs() < 1e-6 * th && (valley_profile(hi) - th).abs() < 1e-6 * th);
@@ -630,8 +613,8 @@ mod tests {
         let f_min = f_at(&u);
         let th = threshold(f_min, 20, 2).unwrap();
         let pr = profile_unit(&src, &u, 0, f_min, th, Some(0.05), &ProfileOptions::default()).unwrap();
-        assert_eq!(pr.upper, UnitEnd::AtBound(1.0));
-        assert!(pr.lower.is_crossed_unit(), "{:?}", pr.lower);
+        assert_eq!(pr.upper, End::AtBound(1.0));
+        assert!(pr.lower.is_crossed(), "{:?}", pr.lower);
         // Profiled from a point that is not the fit: the other coordinate's minimum is found.
         let start = vec![0.5, 0.9];
         let pr =
