@@ -447,6 +447,13 @@ fn run_profile(
         End::AtBound(v) => format!("{v:.6e} (bound)"),
         End::NotReached(v) => format!("beyond {v:.6e}"),
     };
+    for (path, from, to) in &report.recentred {
+        println!(
+            "note: the profile of `{path}` found a better fit than the result's (f = {from:.6e} → {to:.6e}, refitted \
+             with every parameter free): the identification stopped short of the minimum; the intervals below \
+             are centred on the better fit (its values in profile.json, `centre`)"
+        );
+    }
     println!(
         "  {:<24} {:>13} {:>11}  {:>29}  {:>29}",
         "parameter", "value", "std error", "linearised 95 % interval", "profile 95 % interval"
@@ -465,8 +472,8 @@ fn run_profile(
         );
         if let Some(b) = &p.profile.better {
             println!(
-                "warning: profiling `{}` found a better fit (f = {:.6e} against {:.6e}) at {} = {:.6e}: the \
-                 identification stopped short of the minimum; identify again from there",
+                "warning: profiling `{}` found a better fit still (f = {:.6e} against {:.6e}) at {} = {:.6e}: the \
+                 intervals are not centred on a minimum; identify again from there",
                 p.path, b.objective, p.profile.best_objective, p.path, b.value
             );
         }

@@ -403,6 +403,31 @@ fn a_fit_is_profiled_and_its_interval_brackets_it() {
     assert!(p["linearised"].as_array().is_some_and(|v| v.len() == 2));
     assert!(prof.join("profile-law_g_ic.png").exists() && prof.join("profile.csv").exists());
 
+    assert!(report["recentred"].as_array().unwrap().is_empty(), "{report}");
+
+    // A result that is not at the minimum (G_Ic moved by 2 %, about two standard errors): the
+    // profile finds a better fit, moves there and centres the interval on it.
+    let mut off: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&from).unwrap()).unwrap();
+    let g = off["parameters"]["law.g_ic"]["value"].as_f64().unwrap();
+    off["parameters"]["law.g_ic"]["value"] = serde_json::json!(1.02 * g);
+    let off_path = fit.join("off.json");
+    std::fs::write(&off_path, off.to_string()).unwrap();
+    let prof2 = scratch("profile-off");
+    let mut args = vec!["profile", "examples/hartlen-dcb/dcb01.toml", "--from", off_path.to_str().unwrap()];
+    args.extend(["--parameters", "law.g_ic", "--out", prof2.to_str().unwrap()]);
+    args.extend(coarse);
+    let r = czid(&args);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert!(String::from_utf8_lossy(&r.stdout).contains("found a better fit than the result's"));
+    let moved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(prof2.join("profile.json")).unwrap()).unwrap();
+    assert!(!moved["recentred"].as_array().unwrap().is_empty(), "{moved}");
+    let (lo, hi) = (lower["value"].as_f64().unwrap(), upper["value"].as_f64().unwrap());
+    let centre = moved["centre"]["law.g_ic"].as_f64().unwrap();
+    assert!(centre > lo && centre < hi, "centred on {centre}, the fit's interval {lo}–{hi}");
+    assert!(moved["centre_objective"].as_f64().unwrap() <= f0 * (1.0 + 1e-3), "{moved}");
+    std::fs::remove_dir_all(&prof2).ok();
+
     // An unknown parameter is named with the problem's parameters; no steps is refused.
     let r = czid(&[
         "profile",

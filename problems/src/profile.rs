@@ -278,16 +278,47 @@ fn refine<S: ResidualSource<Error = CzError>>(
     Ok(a.value - ga * (b.value - a.value) / (gb - ga))
 }
 
+/// How often [`profiles`] moves to a better fit that a profile turned up before it reports one.
+const RECENTRES: usize = 2;
+
+/// A move of the profiles' centre to a better fit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Recentre {
+    /// Index of the parameter whose profile found it.
+    pub by: usize,
+    /// The objective at the old centre and at the new one (refitted with every parameter free).
+    pub from: f64,
+    /// See `from`.
+    pub to: f64,
+}
+
+/// What [`profiles`] found.
+#[derive(Clone, Debug)]
+pub struct Profiles {
+    /// The point the intervals are centred on (physical values): the fit profiled, or a better
+    /// one its profiles found (see `recentred`).
+    pub centre: Vec<f64>,
+    /// The objective there.
+    pub centre_objective: f64,
+    /// Moves to better fits, in order.
+    pub recentred: Vec<Recentre>,
+    /// One profile per parameter asked for.
+    pub profiles: Vec<Profile>,
+}
+
 /// Profiles the parameters `which` (indices into the problem's parameters) of an identification
-/// at its fit `x` (physical values): each one's 95 % interval, its points, and a better fit if one
-/// turned up. `done` is called after each parameter (for progress).
+/// at its fit `x` (physical values): each one's 95 % interval and its points. A profile that finds
+/// a better fit than `x` (the identification stopped short of the minimum: a rough objective, a
+/// budget spent) moves the centre there, refitted with every parameter free, and the profiles start
+/// again from it, up to twice; a better fit found after that is reported in its profile. `done` is
+/// called after each parameter (for progress).
 pub fn profiles(
     id: &Identification,
     x: &[f64],
     which: &[usize],
     opts: &ProfileOptions,
     mut done: impl FnMut(&Profile),
-) -> Result<Vec<Profile>> {
+) -> Result<Profiles> {
     let space = id.space();
     let p = space.parameters().len();
     if x.len() != p {
@@ -296,46 +327,65 @@ pub fn profiles(
     if let Some(j) = which.iter().find(|&&j| j >= p) {
         return Err(CzError::config("profile", format!("no parameter {j} in a problem of {p}")));
     }
-    let u = space.to_unit(x);
     let src = Parallel(|w: &[f64]| -> Result<Vec<f64>> { Ok(id.simulate(&space.from_unit(w))?.evaluation.residuals) });
-    let r0 = src.residuals_at(&u)?;
-    let f_min: f64 = r0.iter().map(|v| v * v).sum();
-    let n = r0.len();
-    let threshold = threshold(f_min, n, p).ok_or_else(|| {
-        CzError::config("profile", format!("{n} residuals for {p} parameters: no interval without more residuals"))
-    })?;
-    let assessment = assess(id, &u)?;
-    let mut out = Vec::with_capacity(which.len());
-    for &j in which {
-        let se = assessment.standard_errors[j];
-        // The standard error in unit-cube coordinates, for the first step.
-        let se_u = se.map(|s| {
-            let (a, b) = (space.to_unit(&with(x, j, x[j] - s))[j], space.to_unit(&with(x, j, x[j] + s))[j]);
-            0.5 * (b - a).abs()
-        });
-        let up = profile_unit(&src, &u, j, f_min, threshold, se_u, opts)?;
-        let phys = |v: f64| space.from_unit(&with(&u, j, v))[j];
-        let end = |e: End| match e {
-            End::Crossed(v) => End::Crossed(phys(v)),
-            End::AtBound(v) => End::AtBound(phys(v)),
-            End::NotReached(v) => End::NotReached(phys(v)),
-        };
-        let point = |q: &UnitPoint| ProfilePoint { value: phys(q.value), objective: q.objective, at: q.at.clone() };
-        let profile = Profile {
-            parameter: j,
-            best: x[j],
-            standard_error: se,
-            best_objective: f_min,
-            threshold,
-            lower: end(up.lower),
-            upper: end(up.upper),
-            points: up.points.iter().map(point).collect(),
-            better: up.better.as_ref().map(point),
-        };
-        done(&profile);
-        out.push(profile);
+    let mut u = space.to_unit(x);
+    let mut recentred = Vec::new();
+    'centre: loop {
+        let x = space.from_unit(&u);
+        let r0 = src.residuals_at(&u)?;
+        let f_min: f64 = r0.iter().map(|v| v * v).sum();
+        let n = r0.len();
+        let threshold = threshold(f_min, n, p).ok_or_else(|| {
+            CzError::config("profile", format!("{n} residuals for {p} parameters: no interval without more residuals"))
+        })?;
+        let assessment = assess(id, &u)?;
+        let mut out = Vec::with_capacity(which.len());
+        for &j in which {
+            let se = assessment.standard_errors[j];
+            // The standard error in unit-cube coordinates, for the first step.
+            let se_u = se.map(|s| {
+                let (a, b) = (space.to_unit(&with(&x, j, x[j] - s))[j], space.to_unit(&with(&x, j, x[j] + s))[j]);
+                0.5 * (b - a).abs()
+            });
+            let up = profile_unit(&src, &u, j, f_min, threshold, se_u, opts)?;
+            if let Some(b) = up.better.as_ref().filter(|_| recentred.len() < RECENTRES) {
+                let polished = polish(&src, &b.at, opts)?;
+                let next = if polished.objective < b.objective { polished } else { b.clone() };
+                recentred.push(Recentre { by: j, from: f_min, to: next.objective });
+                u = next.at;
+                continue 'centre;
+            }
+            let phys = |v: f64| space.from_unit(&with(&u, j, v))[j];
+            let end = |e: End| match e {
+                End::Crossed(v) => End::Crossed(phys(v)),
+                End::AtBound(v) => End::AtBound(phys(v)),
+                End::NotReached(v) => End::NotReached(phys(v)),
+            };
+            let point = |q: &UnitPoint| ProfilePoint { value: phys(q.value), objective: q.objective, at: q.at.clone() };
+            let profile = Profile {
+                parameter: j,
+                best: x[j],
+                standard_error: se,
+                best_objective: f_min,
+                threshold,
+                lower: end(up.lower),
+                upper: end(up.upper),
+                points: up.points.iter().map(point).collect(),
+                better: up.better.as_ref().map(point),
+            };
+            done(&profile);
+            out.push(profile);
+        }
+        return Ok(Profiles { centre: x, centre_objective: f_min, recentred, profiles: out });
     }
-    Ok(out)
+}
+
+/// A Levenberg–Marquardt fit of every coordinate from `start`.
+fn polish<S: ResidualSource<Error = CzError>>(src: &S, start: &[f64], opts: &ProfileOptions) -> Result<UnitPoint> {
+    let mut lm = LmOptions::unit_cube(start.len(), opts.fd_step);
+    lm.max_iterations = opts.fit_iterations;
+    let out = least_squares::minimize(src, start, &lm, None)?;
+    Ok(UnitPoint { value: f64::NAN, objective: out.cost, at: out.z })
 }
 
 /// `profile.json`.
@@ -349,6 +399,13 @@ pub struct ProfileReport {
     pub residuals: usize,
     /// Parameters.
     pub parameters: usize,
+    /// The values the intervals are centred on, by path: the result's, or a better fit the
+    /// profiles found (see `recentred`).
+    pub centre: std::collections::BTreeMap<String, f64>,
+    /// The objective there.
+    pub centre_objective: f64,
+    /// Moves to better fits: the parameter whose profile found one, the objective before and after.
+    pub recentred: Vec<(String, f64, f64)>,
     /// One profile per parameter asked for, with its path and unit.
     pub profiles: Vec<NamedProfile>,
 }
@@ -405,12 +462,14 @@ pub fn profile_fit(
     let id = problem.identification()?;
     let params = id.space().parameters();
     let found = profiles(&id, &calibration.x, idx, opts, |p| done(&params[p.parameter].path, p))?;
+    let centre = params.iter().zip(&found.centre).map(|(q, v)| (q.path.clone(), *v)).collect();
+    let recentred = found.recentred.iter().map(|r| (params[r.by].path.clone(), r.from, r.to)).collect();
     let residuals = id.simulate(&calibration.x)?.evaluation.residuals.len();
     let p = params.len();
     let t = f_quantile(LEVEL, 1.0, (residuals - p) as f64).sqrt();
     let mut named = Vec::new();
     let (mut cols, mut names): (Vec<Vec<f64>>, Vec<String>) = (vec![Vec::new(); 3], Vec::new());
-    for pr in found {
+    for pr in found.profiles {
         let prm = &params[pr.parameter];
         let linearised = pr.standard_error.map(|se| [pr.best - t * se, pr.best + t * se]);
         for q in &pr.points {
@@ -450,6 +509,9 @@ pub fn profile_fit(
         from: calibration.from.clone(),
         residuals,
         parameters: p,
+        centre,
+        centre_objective: found.centre_objective,
+        recentred,
         profiles: named,
     };
     let json = serde_json::to_string_pretty(&report).map_err(|e| CzError::config("profile", e.to_string()))?;
