@@ -404,6 +404,20 @@ fn a_fit_is_profiled_and_its_interval_brackets_it() {
     assert!(prof.join("profile-law_g_ic.png").exists() && prof.join("profile.csv").exists());
 
     assert!(report["recentred"].as_array().unwrap().is_empty(), "{report}");
+    // The same profile on one thread: the same file, byte for byte.
+    let one = scratch("profile-one-thread");
+    let mut args1 = args.clone();
+    let at = args1.iter().position(|a| *a == prof.to_str().unwrap()).unwrap();
+    args1[at] = one.to_str().unwrap();
+    let r = Command::new(env!("CARGO_BIN_EXE_czid"))
+        .args(&args1)
+        .env("RAYON_NUM_THREADS", "1")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert_eq!(std::fs::read(one.join("profile.json")).unwrap(), std::fs::read(prof.join("profile.json")).unwrap());
+    std::fs::remove_dir_all(&one).ok();
 
     // A result that is not at the minimum (G_Ic moved by 2 %, about two standard errors): the
     // profile finds a better fit, moves there and centres the interval on it.
