@@ -126,7 +126,7 @@ pub fn threshold(f_min: f64, n: usize, p: usize) -> Option<f64> {
 /// Profiles coordinate `j` of a least-squares problem on the unit cube: `src` gives the residuals
 /// (`f = ||r||²`) at unit-cube points, `u` is the fit, `f_min` its objective, `se_u` the
 /// linearised standard error of coordinate `j` (unit cube; sets the first step). Values are
-/// reported in unit-cube coordinates (see [`profile`] for physical ones).
+/// reported in unit-cube coordinates (see [`profiles`] for physical ones).
 pub fn profile_unit<S: ResidualSource<Error = CzError>>(
     src: &S,
     u: &[f64],

@@ -34,7 +34,7 @@
 //! **Energy.** External work `∫ P d(e·q)` (trapezoidal rule over steps); elastic energy: the
 //! linear layers' exact strain energy, the fibres' recoverable energy and the interface's
 //! (law plus compliance, `½ T·C T`); dissipated energy of the interface (work along each point's gap
-//! path by [`super::energy::path_work`] minus its recoverable energy) and of the fibres (work by
+//! path by `energy::path_work` minus its recoverable energy) and of the fibres (work by
 //! [`fibre::FibreMaterial::step_work`] minus recoverable energy), each integrated point by point and
 //! independently of the external work, so `W = U + D_interface + D_material` is a genuine check.
 //!

@@ -1,4 +1,4 @@
-//! Least squares on residual vectors: one finite-difference [`jacobian`] and one
+//! Least squares on residual vectors: one finite-difference [`jacobian()`] and one
 //! [`levenberg_marquardt::minimize`], shared by the registry's Levenberg–Marquardt (`czid
 //! identify`), Gauss–Newton, the identifiability analysis and the diagnosis's base fit and refits.
 //!

@@ -131,7 +131,7 @@ impl MigaSettings {
 }
 
 /// The multi-island GA (registry name `miga`); with one island, the single-population GA
-/// (`ga`, see [`crate::ga`]).
+/// (`ga`, see [`crate::ga`](mod@crate::ga)).
 #[derive(Clone, Debug)]
 pub struct Miga {
     name: &'static str,

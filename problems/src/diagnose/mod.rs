@@ -9,7 +9,7 @@
 //! * [`score`]: score statistics at the base fit, confounding, absorbing parameter.
 //! * [`run`]: the whole diagnosis ([`run::diagnose`]), its outline calling the [`stages`] in
 //!   turn, and its report ([`report`]).
-//! * [`bench`]: planted-effect cases with a known answer.
+//! * [`bench`](mod@bench): planted-effect cases with a known answer.
 
 pub mod bench;
 pub mod candidate;

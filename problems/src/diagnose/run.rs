@@ -45,7 +45,7 @@ pub struct Options {
     /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
     pub always_refit: Vec<String>,
     /// Account for the model-form misfit with the models' reference models
-    /// ([`stages::model_form`]) before judging any candidate.
+    /// ([`super::stages::model_form`]) before judging any candidate.
     pub model_form: bool,
     /// Called with a short message as each stage starts (e.g. for a progress display).
     pub progress: Option<ProgressFn>,
