@@ -477,6 +477,9 @@ fn run_profile(
                 p.path, b.objective, p.profile.best_objective, p.path, b.value
             );
         }
+        for (v, why) in &p.profile.failures {
+            println!("note: `{}`: the refit at {v:.6e} failed, so its side ends before it: {why}", p.path);
+        }
         for note in &p.notes {
             println!("note: `{}`: {note}", p.path);
         }

@@ -89,6 +89,8 @@ pub struct Profile {
     pub points: Vec<ProfilePoint>,
     /// A point with a lower objective than the fit, if the profile found one.
     pub better: Option<ProfilePoint>,
+    /// Refits that failed, the parameter's value (physical unit) and why: the side ended there.
+    pub failures: Vec<(f64, String)>,
 }
 
 /// Settings of a profile.
@@ -151,6 +153,7 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
     let first = se_u.filter(|s| s.is_finite() && *s > 0.0).map_or(0.02, |s| (0.7 * s).clamp(1e-4, 0.1));
     let mut points = vec![UnitPoint { value: u[j], objective: f_min, at: u.to_vec() }];
     let mut ends = [End::NotReached(u[j]); 2];
+    let mut failures = Vec::new();
     for (side, dir) in [-1.0f64, 1.0].into_iter().enumerate() {
         let mut prev = points[0].clone();
         let mut h = first;
@@ -161,11 +164,25 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
                 ends[side] = End::AtBound(v);
                 break;
             }
-            let next = fit_at(src, &prev.at, j, v, opts)?;
+            // A model that fails there (a run that does not converge, a finite difference that
+            // cannot be taken) ends this side where it last succeeded, said in `failures`.
+            let next = match fit_at(src, &prev.at, j, v, opts) {
+                Ok(next) => next,
+                Err(e) => {
+                    failures.push((v, e.to_string()));
+                    break;
+                }
+            };
             points.push(next.clone());
             if next.objective > threshold {
-                let crossing = refine(src, &prev, &next, j, threshold, gap, opts, &mut points)?;
-                ends[side] = End::Crossed(crossing);
+                match refine(src, &prev, &next, j, threshold, gap, opts, &mut points) {
+                    Ok(crossing) => ends[side] = End::Crossed(crossing),
+                    Err(e) => {
+                        // Bracketed all the same: the crossing lies between the two points.
+                        failures.push((v, e.to_string()));
+                        ends[side] = End::Crossed(next.value);
+                    }
+                }
                 break;
             }
             if v == 0.0 || v == 1.0 {
@@ -173,8 +190,8 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
                 break;
             }
             ends[side] = End::NotReached(v);
-            // Aim each step at a quarter of the way to the threshold: a profile is near-quadratic
-            // close to the fit, so a small rise allows a longer step.
+            // Keep each step's rise between a tenth and a half of the way to the threshold: a
+            // profile is near-quadratic close to the fit, so a small rise allows a longer step.
             let rise = next.objective - prev.objective;
             h *= if rise < 0.1 * gap {
                 2.0
@@ -191,7 +208,7 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
     // A fit that was not quite converged is not news: report a better point only when it lies
     // below the fit by a twentieth of the interval's rise, enough to move the interval.
     let better = lowest.filter(|p| p.objective < f_min - 0.05 * gap);
-    Ok(UnitProfile { lower: ends[0], upper: ends[1], points, better })
+    Ok(UnitProfile { lower: ends[0], upper: ends[1], points, better, failures })
 }
 
 /// A point of a profile in unit-cube coordinates.
@@ -216,6 +233,8 @@ pub struct UnitProfile {
     pub points: Vec<UnitPoint>,
     /// A point below the fit's objective, if found.
     pub better: Option<UnitPoint>,
+    /// Refits that failed: the profiled coordinate and why (the side ended there).
+    pub failures: Vec<(f64, String)>,
 }
 
 /// The minimum over the other coordinates with coordinate `j` fixed at `v`, started from `start`.
@@ -372,6 +391,7 @@ pub fn profiles(
                 upper: end(up.upper),
                 points: up.points.iter().map(point).collect(),
                 better: up.better.as_ref().map(point),
+                failures: up.failures.iter().map(|(v, e)| (phys(*v), e.clone())).collect(),
             };
             done(&profile);
             out.push(profile);
@@ -698,6 +718,7 @@ mod tests {
             upper: End::Crossed(hi),
             points: Vec::new(),
             better: None,
+            failures: Vec::new(),
         };
         // t SE = 2: sides at 1.8 and 2.5 from the fit are what a smooth objective gives.
         assert!(narrowness(&pr(8.2, 12.5), 2.0).is_empty());
@@ -705,5 +726,27 @@ mod tests {
         let notes = narrowness(&pr(9.9, 12.5), 2.0);
         assert_eq!(notes.len(), 1);
         assert!(notes[0].starts_with("the lower side ends 1.000e-1 from the fit"), "{}", notes[0]);
+    }
+
+    #[test]
+    fn a_model_that_fails_ends_its_side_where_it_last_ran() {
+        // The "model" fails for u0 above 0.55; the fit is at 0.5 and the threshold lies beyond.
+        let src = Parallel(|u: &[f64]| -> Result<Vec<f64>> {
+            if u[0] > 0.55 {
+                return Err(CzError::Simulation(format!("no convergence at {}", u[0])));
+            }
+            let mut r = vec![0.005; 20];
+            r[0] = 0.01 * (u[0] - 0.5);
+            r[1] = u[1] - 0.5;
+            Ok(r)
+        });
+        let u = vec![0.5, 0.5];
+        let f_min = 20.0 * 0.005f64.powi(2) - 0.005f64.powi(2);
+        let th = threshold(f_min, 20, 2).unwrap();
+        let pr = profile_unit(&src, &u, 0, f_min, th, Some(0.02), &ProfileOptions::default()).unwrap();
+        let End::NotReached(v) = pr.upper else { panic!("{:?}", pr.upper) };
+        assert!((0.5..=0.55).contains(&v), "{v}");
+        assert!(!pr.failures.is_empty() && pr.failures[0].0 > 0.55, "{:?}", pr.failures);
+        assert!(pr.failures[0].1.contains("no convergence"), "{:?}", pr.failures);
     }
 }
