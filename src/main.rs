@@ -439,6 +439,11 @@ fn run_profile(
     let dir = OutputDir::create(&out.out, out.force, false)?;
     let opts = ProfileOptions { max_steps, fd_step, ..Default::default() };
     let started = std::time::Instant::now();
+    eprintln!(
+        "profiling {} parameter(s) of {}: each takes some ten to twenty refits",
+        idx.len(),
+        problem.path.display()
+    );
     let report = profile_fit(&problem, &calibration, &idx, &opts, &dir, |path, p| {
         eprintln!("profiled {path} ({} fits, {:.0} s so far)", p.points.len() - 1, started.elapsed().as_secs_f64());
     })?;
@@ -488,6 +493,9 @@ fn run_profile(
                 End::AtBound(_) => {
                     println!("note: `{}` is not bounded by the data on its {name} side within its bounds", p.path)
                 }
+                // A side that a failed refit ended is said above.
+                End::NotReached(_)
+                    if p.profile.failures.iter().any(|(v, _)| (*v < p.profile.best) == (name == "lower")) => {}
                 End::NotReached(_) => println!(
                     "note: the {name} side of `{}` was not reached in {max_steps} steps (raise --max-steps)",
                     p.path
