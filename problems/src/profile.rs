@@ -60,7 +60,8 @@ impl End {
 /// One point of a profile.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ProfilePoint {
-    /// The profiled parameter's value (physical unit).
+    /// The profiled parameter's value (physical unit in a [`Profile`], unit-cube coordinates in a
+    /// [`UnitProfile`]).
     pub value: f64,
     /// The objective minimised over the other parameters.
     pub objective: f64,
@@ -151,7 +152,7 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
     // The linear prediction of the interval's half width is √F·SE ≈ 2 SE: the first step goes a
     // third of that way, so that a nearly quadratic profile crosses within a few steps.
     let first = se_u.filter(|s| s.is_finite() && *s > 0.0).map_or(0.02, |s| (0.7 * s).clamp(1e-4, 0.1));
-    let mut points = vec![UnitPoint { value: u[j], objective: f_min, at: u.to_vec() }];
+    let mut points = vec![ProfilePoint { value: u[j], objective: f_min, at: u.to_vec() }];
     let mut ends = [End::NotReached(u[j]); 2];
     let mut failures = Vec::new();
     for (side, dir) in [-1.0f64, 1.0].into_iter().enumerate() {
@@ -211,17 +212,6 @@ pub fn profile_unit<S: ResidualSource<Error = CzError>>(
     Ok(UnitProfile { lower: ends[0], upper: ends[1], points, better, failures })
 }
 
-/// A point of a profile in unit-cube coordinates.
-#[derive(Clone, Debug, PartialEq)]
-pub struct UnitPoint {
-    /// The profiled coordinate.
-    pub value: f64,
-    /// The minimised objective.
-    pub objective: f64,
-    /// Every coordinate at that minimum.
-    pub at: Vec<f64>,
-}
-
 /// [`profile_unit`]'s result.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UnitProfile {
@@ -230,9 +220,9 @@ pub struct UnitProfile {
     /// Upper side.
     pub upper: End,
     /// Points sorted by the profiled coordinate.
-    pub points: Vec<UnitPoint>,
+    pub points: Vec<ProfilePoint>,
     /// A point below the fit's objective, if found.
-    pub better: Option<UnitPoint>,
+    pub better: Option<ProfilePoint>,
     /// Refits that failed: the profiled coordinate and why (the side ended there).
     pub failures: Vec<(f64, String)>,
 }
@@ -244,14 +234,14 @@ fn fit_at<S: ResidualSource<Error = CzError>>(
     j: usize,
     v: f64,
     opts: &ProfileOptions,
-) -> Result<UnitPoint> {
+) -> Result<ProfilePoint> {
     let mut z0 = start.to_vec();
     z0[j] = v;
     let mut lm = LmOptions::unit_cube(z0.len(), opts.fd_step);
     lm.max_iterations = opts.fit_iterations;
     lm.fixed = vec![j];
     let out = least_squares::minimize(src, &z0, &lm, None)?;
-    Ok(UnitPoint { value: v, objective: out.cost, at: out.z })
+    Ok(ProfilePoint { value: v, objective: out.cost, at: out.z })
 }
 
 /// Places the crossing of `threshold` between `a` (below) and `b` (above) by regula falsi with
@@ -259,13 +249,13 @@ fn fit_at<S: ResidualSource<Error = CzError>>(
 #[allow(clippy::too_many_arguments)]
 fn refine<S: ResidualSource<Error = CzError>>(
     src: &S,
-    a: &UnitPoint,
-    b: &UnitPoint,
+    a: &ProfilePoint,
+    b: &ProfilePoint,
     j: usize,
     threshold: f64,
     gap: f64,
     opts: &ProfileOptions,
-    points: &mut Vec<UnitPoint>,
+    points: &mut Vec<ProfilePoint>,
 ) -> Result<f64> {
     let (mut a, mut b) = (a.clone(), b.clone());
     let (mut ga, mut gb) = (a.objective - threshold, b.objective - threshold);
@@ -380,7 +370,8 @@ pub fn profiles(
                 End::AtBound(v) => End::AtBound(phys(v)),
                 End::NotReached(v) => End::NotReached(phys(v)),
             };
-            let point = |q: &UnitPoint| ProfilePoint { value: phys(q.value), objective: q.objective, at: q.at.clone() };
+            let point =
+                |q: &ProfilePoint| ProfilePoint { value: phys(q.value), objective: q.objective, at: q.at.clone() };
             let profile = Profile {
                 parameter: j,
                 best: x[j],
@@ -401,11 +392,11 @@ pub fn profiles(
 }
 
 /// A Levenberg–Marquardt fit of every coordinate from `start`.
-fn polish<S: ResidualSource<Error = CzError>>(src: &S, start: &[f64], opts: &ProfileOptions) -> Result<UnitPoint> {
+fn polish<S: ResidualSource<Error = CzError>>(src: &S, start: &[f64], opts: &ProfileOptions) -> Result<ProfilePoint> {
     let mut lm = LmOptions::unit_cube(start.len(), opts.fd_step);
     lm.max_iterations = opts.fit_iterations;
     let out = least_squares::minimize(src, start, &lm, None)?;
-    Ok(UnitPoint { value: f64::NAN, objective: out.cost, at: out.z })
+    Ok(ProfilePoint { value: f64::NAN, objective: out.cost, at: out.z })
 }
 
 /// `profile.json`.
