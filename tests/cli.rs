@@ -379,6 +379,10 @@ fn a_fit_is_profiled_and_its_interval_brackets_it() {
     args.extend(coarse);
     let r = czid(&args);
     assert!(r.status.success(), "{}", stderr(&r));
+    // The strength's standard error is wide: the identification points to a profile.
+    let said = String::from_utf8_lossy(&r.stdout);
+    assert!(said.contains("`law.strength_n` is determined only to ± ") && said.contains("czid profile"), "{said}");
+    assert!(!said.contains("`law.g_ic` is determined only to"), "{said}");
     let from = fit.join("result.json");
     let mut args = vec!["profile", "examples/hartlen-dcb/dcb01.toml", "--from", from.to_str().unwrap()];
     args.extend(["--parameters", "law.g_ic", "--out", prof.to_str().unwrap()]);

@@ -275,6 +275,11 @@ fn unconverged(method: &Method, result: &OptimizationResult, budget: usize, iter
     }
 }
 
+/// A relative standard error above which a parameter's linearised uncertainty is worth checking
+/// with a profile (its 95 % interval then spans ± 20 % or more, where the objective is rarely
+/// still a parabola).
+const WIDE_STANDARD_ERROR: f64 = 0.1;
+
 /// Counts the iterations of a run, those before a resume included (iterations are numbered from
 /// 0 across the parts of a resumed run).
 #[derive(Default)]
@@ -392,6 +397,17 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         let verdict = &assessment.verdicts[i];
         if matches!(verdict, Verdict::NotDetermined) {
             warnings.push(format!("`{}` is not determined by these data: its value is arbitrary", p.path));
+        }
+        if let (Verdict::Determined, Some(se)) = (verdict, assessment.standard_errors[i]) {
+            let relative = se / x[i].abs();
+            if relative > WIDE_STANDARD_ERROR {
+                warnings.push(format!(
+                    "`{}` is determined only to ± {:.0} % (its linearised standard error): over so wide a range the \
+                     linearisation can be far off, in either direction; `czid profile` gives its 95 % interval",
+                    p.path,
+                    100.0 * relative
+                ));
+            }
         }
         parameters.insert(
             p.path.clone(),
