@@ -309,6 +309,9 @@ pub struct Profiles {
     pub centre: Vec<f64>,
     /// The objective there.
     pub centre_objective: f64,
+    /// Residuals of the objective (the intervals' degrees of freedom are this minus the
+    /// parameters).
+    pub residuals: usize,
     /// Moves to better fits, in order.
     pub recentred: Vec<Recentre>,
     /// One profile per parameter asked for.
@@ -387,7 +390,7 @@ pub fn profiles(
             done(&profile);
             out.push(profile);
         }
-        return Ok(Profiles { centre: x, centre_objective: f_min, recentred, profiles: out });
+        return Ok(Profiles { centre: x, centre_objective: f_min, residuals: n, recentred, profiles: out });
     }
 }
 
@@ -475,7 +478,7 @@ pub fn profile_fit(
     let found = profiles(&id, &calibration.x, idx, opts, |p| done(&params[p.parameter].path, p))?;
     let centre = params.iter().zip(&found.centre).map(|(q, v)| (q.path.clone(), *v)).collect();
     let recentred = found.recentred.iter().map(|r| (params[r.by].path.clone(), r.from, r.to)).collect();
-    let residuals = id.simulate(&calibration.x)?.evaluation.residuals.len();
+    let residuals = found.residuals;
     let p = params.len();
     let t = f_quantile(LEVEL, 1.0, (residuals - p) as f64).sqrt();
     let mut named = Vec::new();
