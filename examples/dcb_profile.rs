@@ -1,5 +1,5 @@
 //! Runs a beam-test model repeatedly, for profilers and timing:
-//! `cargo run --release --example dcb_profile -- [paper|hartlen|hartlen-large|enf|mmb] [runs]`
+//! `cargo run --release --example dcb_profile -- [paper|hartlen|hartlen-large|hartlen-large-coarse|enf|mmb] [runs]`
 //! (defaults: paper, 20). The paper's DCB with the identified law (Shi & Zhang, Table 3), Hartlen's
 //! DCB-01 with a bilinear law (G_Ic = 0.8 N/mm), the same with large rotations (co-rotational, whole
 //! mesh), Hartlen's ENF-03 at its identified law and an MMB at G_II/G = 0.5: the runs of
@@ -23,6 +23,12 @@ fn main() {
         "hartlen-large" => {
             let mut d = Dcb::hartlen_dcb01();
             d.effects.large_rotation = true;
+            (d, Box::new(Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap()))
+        }
+        "hartlen-large-coarse" => {
+            let mut d = Dcb::hartlen_dcb01();
+            d.effects.large_rotation = true;
+            d.mesh.interface_subdivision = 1;
             (d, Box::new(Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap()))
         }
         _ => (Dcb::paper(), Box::new(StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap())),

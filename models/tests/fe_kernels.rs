@@ -57,7 +57,9 @@ fn large_rotation_gap_derivatives_match_finite_differences() {
             for c in 0..2 {
                 let fd = (kp.gap[c] - km.gap[c]) / (2.0 * h);
                 assert!((fd - k.grad[c][a]).abs() < 1e-8, "grad {c} {a}");
-                for b in 0..8 {
+                // (On a symmetry plane only the upper side's block is written: the lower side
+                // has no unknowns.)
+                for b in (0..8).filter(|&b| k.dofs[b] != usize::MAX) {
                     let fdh = (kp.grad[c][b] - km.grad[c][b]) / (2.0 * h);
                     assert!((fdh - h0[c][b][a]).abs() < 1e-6, "hess {c} {b} {a}: {fdh} vs {}", h0[c][b][a]);
                 }

@@ -81,6 +81,15 @@ pub enum InterfaceRule {
 struct PointData {
     kin: GapKinematics,
     d: Tangent,
+    /// The unknowns are among `kin.dofs[first..]`: 4 on a symmetry plane (no lower side), else 0.
+    first: usize,
+}
+
+impl PointData {
+    fn new(kin: GapKinematics, d: Tangent) -> Self {
+        let first = if kin.dofs[..4].iter().all(|&d| d == NONE) { 4 } else { 0 };
+        PointData { kin, d, first }
+    }
 }
 
 /// Assembly workspace for one [`FeProblem`].
@@ -198,8 +207,26 @@ impl Assembler {
         f: &mut [f64],
         secant: bool,
     ) -> bool {
-        k.copy_from(&self.linear);
-        self.linear.mul_vec(q, f);
+        if p.large_rotation {
+            // The constant part is the springs alone: added directly rather than by copying and
+            // multiplying a band that is empty elsewhere.
+            k.clear();
+            f.fill(0.0);
+            for s in &p.springs {
+                let e = s.ci * q[s.i] - get(q, s.j);
+                f[s.i] += s.k * s.ci * e;
+                k.add(s.i, s.i, s.k * s.ci * s.ci);
+                if s.j != NONE {
+                    f[s.j] -= s.k * e;
+                    k.add(s.j, s.j, s.k);
+                    k.add(s.i, s.j, -s.k * s.ci);
+                    k.add(s.j, s.i, -s.k * s.ci);
+                }
+            }
+        } else {
+            k.copy_from(&self.linear);
+            self.linear.mul_vec(q, f);
+        }
         if p.large_rotation {
             for e in &self.elements {
                 let mut qe = [0.0; 6];
@@ -218,7 +245,11 @@ impl Assembler {
         }
         let mut ok = true;
         for (ip, pt) in p.points.iter().enumerate() {
-            let kin = interface::kinematics(&p.mesh, pt, q, p.large_rotation, &mut self.hess);
+            // A point integrated through its segments keeps its Hessians for them; the others
+            // use them at once.
+            let hess =
+                if self.covered[ip] && !self.hessians.is_empty() { &mut self.hessians[ip] } else { &mut *self.hess };
+            let kin = interface::kinematics(&p.mesh, pt, q, p.large_rotation, hess);
             let gap = Gap::new(kin.gap[0], kin.gap[1]);
             let (ev, d) = match pt.kind {
                 PointKind::Cohesive => {
@@ -251,10 +282,7 @@ impl Assembler {
             self.gaps[ip] = gap;
             if self.covered[ip] {
                 // Integrated through its segments below.
-                self.data[ip] = PointData { kin, d };
-                if kin.nonlinear {
-                    self.hessians[ip] = *self.hess;
-                }
+                self.data[ip] = PointData::new(kin, d);
                 continue;
             }
             let w = pt.area * pt.factor;
@@ -295,42 +323,13 @@ impl Assembler {
             let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), law, self.mode_one.as_ref());
             self.fronts[is] = sf.fronts;
             self.segment_stored[is] = sf.stored;
-            let pts = [sg.a, sg.b];
-            for (i, &pi) in pts.iter().enumerate() {
-                let ki = &self.data[pi].kin;
-                let fi = sf.f[i];
-                for r in 0..8 {
-                    let dr = ki.dofs[r];
-                    if dr == NONE {
-                        continue;
-                    }
-                    let (g0, g1) = (ki.grad[0][r], ki.grad[1][r]);
-                    if g0 == 0.0 && g1 == 0.0 && !ki.nonlinear {
-                        continue;
-                    }
-                    f[dr] += g0 * fi[0] + g1 * fi[1];
-                    // Row r of G_iᵀ J_ij, times G_j.
-                    for (j, &pj) in pts.iter().enumerate() {
-                        let kj = &self.data[pj].kin;
-                        let jac = &sf.jac[i][j];
-                        let ra0 = g0 * jac[(0, 0)] + g1 * jac[(1, 0)];
-                        let ra1 = g0 * jac[(0, 1)] + g1 * jac[(1, 1)];
-                        for c in 0..8 {
-                            let dc = kj.dofs[c];
-                            if dc == NONE {
-                                continue;
-                            }
-                            let mut v = ra0 * kj.grad[0][c] + ra1 * kj.grad[1][c];
-                            if i == j && ki.nonlinear {
-                                let h = &self.hessians[pi];
-                                v += fi[0] * h[0][r][c] + fi[1] * h[1][r][c];
-                            }
-                            if v != 0.0 {
-                                k.add(dr, dc, v);
-                            }
-                        }
-                    }
-                }
+            let pts = [&self.data[sg.a], &self.data[sg.b]];
+            let hess = [self.hessians.get(sg.a), self.hessians.get(sg.b)];
+            // Both points on a symmetry plane (a half DCB): only their upper sides have unknowns.
+            if pts[0].first == 4 && pts[1].first == 4 {
+                add_segment::<4>(k, f, pts, hess, &sf);
+            } else {
+                add_segment::<0>(k, f, pts, hess, &sf);
             }
         }
         ok
@@ -392,6 +391,54 @@ impl Assembler {
     }
 }
 
+/// Adds a segment's forces `G_iᵀ f_i` and tangent `G_iᵀ J_ij G_j` (plus `f_i · H_i` for a point
+/// with nonlinear kinematics) for its end points `pts`, whose unknowns are among
+/// `kin.dofs[FIRST..]` (a constant, so the loops unroll).
+fn add_segment<const FIRST: usize>(
+    k: &mut BandMatrix,
+    f: &mut [f64],
+    pts: [&PointData; 2],
+    hess: [Option<&interface::Hessian>; 2],
+    sf: &segment::SegmentForces,
+) {
+    for (i, pi) in pts.iter().enumerate() {
+        let ki = &pi.kin;
+        let fi = sf.f[i];
+        for r in FIRST..8 {
+            let dr = ki.dofs[r];
+            if dr == NONE {
+                continue;
+            }
+            let (g0, g1) = (ki.grad[0][r], ki.grad[1][r]);
+            if g0 == 0.0 && g1 == 0.0 && !ki.nonlinear {
+                continue;
+            }
+            f[dr] += g0 * fi[0] + g1 * fi[1];
+            // Row r of G_iᵀ J_ij, times G_j.
+            for (j, pj) in pts.iter().enumerate() {
+                let kj = &pj.kin;
+                let jac = &sf.jac[i][j];
+                let ra0 = g0 * jac[(0, 0)] + g1 * jac[(1, 0)];
+                let ra1 = g0 * jac[(0, 1)] + g1 * jac[(1, 1)];
+                let h = if i == j && ki.nonlinear { hess[i] } else { None };
+                for c in FIRST..8 {
+                    let dc = kj.dofs[c];
+                    if dc == NONE {
+                        continue;
+                    }
+                    let mut v = ra0 * kj.grad[0][c] + ra1 * kj.grad[1][c];
+                    if let Some(h) = h {
+                        v += fi[0] * h[0][r][c] + fi[1] * h[1][r][c];
+                    }
+                    if v != 0.0 {
+                        k.add(dr, dc, v);
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The iteration tangent of a cohesive point (see [`Assembler`]'s `loading_tangent`), for a law
 /// whose pure-mode strengths are `strength` (absolute values, positive).
 pub(crate) fn loading_tangent(
@@ -437,15 +484,24 @@ fn secant_tangent(gap: &Gap, ev: &LawEval) -> Tangent {
 }
 
 fn scatter(k: &mut BandMatrix, dofs: &[usize; 6], ke: &[[f64; 6]; 6]) {
+    // An element whose unknowns are numbered consecutively (the nodes of one layer without fixed
+    // unknowns) adds whole rows.
+    let d0 = dofs[0];
+    if d0 != NONE && dofs.iter().enumerate().all(|(a, &d)| d == d0 + a) {
+        for (a, row) in ke.iter().enumerate() {
+            k.row_mut(d0 + a).add_run(d0, row);
+        }
+        return;
+    }
     for (a, &da) in dofs.iter().enumerate() {
         if da == NONE {
             continue;
         }
-        for (b, &db) in dofs.iter().enumerate() {
-            if db == NONE || ke[a][b] == 0.0 {
-                continue;
+        let mut row = k.row_mut(da);
+        for (&db, &v) in dofs.iter().zip(&ke[a]) {
+            if db != NONE && v != 0.0 {
+                row.add(db, v);
             }
-            k.add(da, db, ke[a][b]);
         }
     }
 }

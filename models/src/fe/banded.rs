@@ -26,6 +26,30 @@ pub struct BandMatrix {
     inv_pivot: Vec<f64>,
 }
 
+/// One row of a [`BandMatrix`] ([`BandMatrix::row_mut`]).
+pub struct BandRow<'a> {
+    entries: &'a mut [f64],
+    /// Position of column `j` in `entries` minus `j`.
+    offset: isize,
+}
+
+impl BandRow<'_> {
+    /// Adds `v` to the entry in column `j`, which must lie within the band.
+    #[inline]
+    pub fn add(&mut self, j: usize, v: f64) {
+        self.entries[(j as isize + self.offset) as usize] += v;
+    }
+
+    /// Adds `v[k]` to the entry in column `j + k` for every `k` (all within the band).
+    #[inline]
+    pub fn add_run(&mut self, j: usize, v: &[f64]) {
+        let start = (j as isize + self.offset) as usize;
+        for (e, x) in self.entries[start..start + v.len()].iter_mut().zip(v) {
+            *e += x;
+        }
+    }
+}
+
 /// Why a factorisation failed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BandError {
@@ -86,6 +110,13 @@ impl BandMatrix {
         debug_assert!(i.abs_diff(j) <= self.bw, "entry ({i},{j}) outside band {}", self.bw);
         let k = self.idx(i, j);
         self.data[k] += v;
+    }
+
+    /// Row `i`, for adding several entries to it (the row located once).
+    #[inline]
+    pub fn row_mut(&mut self, i: usize) -> BandRow<'_> {
+        let (w, bw) = (self.width, self.bw);
+        BandRow { entries: &mut self.data[i * w..(i + 1) * w], offset: bw as isize - i as isize }
     }
 
     /// Replaces row and column `i` by those of the identity (a prescribed unknown).

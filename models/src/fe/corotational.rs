@@ -43,37 +43,53 @@ pub fn element(s: &Section, x1: f64, x2: f64, q: &[f64; 6]) -> CrElement {
         }
     }
     let energy = 0.5 * (fl[0] * dl[0] + fl[1] * dl[1] + fl[2] * dl[2]);
-    let r = [-c, -sn, 0.0, c, sn, 0.0];
-    let z = [sn, -c, 0.0, -sn, c, 0.0];
-    let mut b = [[0.0; 6]; 3];
-    b[0] = r;
-    for j in 0..6 {
-        b[1][j] = -z[j] / ln;
-        b[2][j] = -z[j] / ln;
-    }
-    b[1][2] += 1.0;
-    b[2][5] += 1.0;
-    let mut force = [0.0; 6];
-    for j in 0..6 {
-        force[j] = b[0][j] * fl[0] + b[1][j] * fl[1] + b[2][j] * fl[2];
-    }
-    let mut tangent = [[0.0; 6]; 6];
-    let mut kb_ = [[0.0; 6]; 3];
-    for a in 0..3 {
-        for j in 0..6 {
-            kb_[a][j] = kl[a][0] * b[0][j] + kl[a][1] * b[1][j] + kl[a][2] * b[2][j];
-        }
-    }
+    // With r = ∂l_n/∂q = (−c, −s, 0, c, s, 0), z = (s, −c, 0, −s, c, 0) and v = −z/l_n, the
+    // strain–displacement rows are b = (r, v + e₂, v + e₅); `bᵀ K_l b` plus the geometric terms
+    // collapses to closed forms: the translational block is ±X with
+    // X = (EA/l₀) r′r′ᵀ + (N/l_n + 2 k_v/l_n²) z′z′ᵀ + g_m (r′z′ᵀ + z′r′ᵀ) on the first node's
+    // (u, w), `k_v = k₁₁ + k₁₂`; the rotations couple to the translations through `k_v v` and to
+    // each other through the local bending and shear stiffness.
+    let (r1, z1) = ([-c, -sn], [sn, -c]);
+    let v = [-z1[0] / ln, -z1[1] / ln];
+    let force = [
+        r1[0] * fl[0] + v[0] * (fl[1] + fl[2]),
+        r1[1] * fl[0] + v[1] * (fl[1] + fl[2]),
+        fl[1],
+        -(r1[0] * fl[0] + v[0] * (fl[1] + fl[2])),
+        -(r1[1] * fl[0] + v[1] * (fl[1] + fl[2])),
+        fl[2],
+    ];
+    let (k11, k12) = (kl[1][1], kl[1][2]);
+    let kv = k11 + k12;
     let gn = fl[0] / ln;
     let gm = (fl[1] + fl[2]) / (ln * ln);
-    for i in 0..6 {
-        for j in 0..6 {
-            tangent[i][j] = b[0][i] * kb_[0][j]
-                + b[1][i] * kb_[1][j]
-                + b[2][i] * kb_[2][j]
-                + z[i] * z[j] * gn
-                + (r[i] * z[j] + z[i] * r[j]) * gm;
+    let a = gn + 2.0 * kv / (ln * ln);
+    let ka = kl[0][0];
+    let mut x = [[0.0; 2]; 2];
+    for i in 0..2 {
+        for j in 0..2 {
+            x[i][j] = ka * r1[i] * r1[j] + a * z1[i] * z1[j] + gm * (r1[i] * z1[j] + z1[i] * r1[j]);
         }
     }
+    let mut tangent = [[0.0; 6]; 6];
+    for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+        tangent[i][j] = x[i][j];
+        tangent[i + 3][j + 3] = x[i][j];
+        tangent[i][j + 3] = -x[i][j];
+        tangent[i + 3][j] = -x[i][j];
+    }
+    for i in 0..2 {
+        let t = kv * v[i];
+        for rot in [2, 5] {
+            tangent[i][rot] = t;
+            tangent[rot][i] = t;
+            tangent[i + 3][rot] = -t;
+            tangent[rot][i + 3] = -t;
+        }
+    }
+    tangent[2][2] = k11;
+    tangent[5][5] = kl[2][2];
+    tangent[2][5] = k12;
+    tangent[5][2] = kl[2][1];
     CrElement { force, tangent, energy }
 }

@@ -110,16 +110,22 @@ fn surface(q: &[f64], dofs: &[usize; 4], z: f64, large: bool) -> Surface {
     r
 }
 
-/// Gap kinematics of point `p` at unknowns `q`; with `large`, also the Hessians into `hess`.
+/// Gap kinematics of point `p` at unknowns `q`; with `large`, also the Hessians into `hess`
+/// (on a symmetry plane only the upper side's block, the only one with unknowns).
 pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess: &mut Hessian) -> GapKinematics {
     let mut k = GapKinematics { dofs: [NONE; 8], ..Default::default() };
-    if large {
-        *hess = [[[0.0; 8]; 8]; 2];
-    }
     let du = mesh.dofs(p.upper, p.node);
     k.dofs[4..8].copy_from_slice(&du);
     let su = surface(q, &du, -0.5 * mesh.layers[p.upper].section.h, large);
     let Some(lo) = p.lower else {
+        // Only the upper side's block is written (and read: the lower side has no unknowns).
+        if large {
+            for side in hess.iter_mut() {
+                for row in &mut side[4..8] {
+                    row[4..8].fill(0.0);
+                }
+            }
+        }
         // Mirror image below: d = (0, 2 p_y), frame fixed by symmetry.
         k.gap[0] = 2.0 * su.p[1];
         for j in 0..4 {
@@ -149,6 +155,7 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess:
         k.grad = [dd[1], dd[0]];
         return k;
     }
+    *hess = [[[0.0; 8]; 8]; 2];
     let tb = 0.5 * (val(q, dl[2]) + val(q, du[2]));
     let (sb, cb) = tb.sin_cos();
     let n = [-sb, cb];
