@@ -18,6 +18,9 @@
 //!   crack growth): `examples/mixed-mode-synthetic/problem.toml`'s MMB at its truth; whole mesh (the
 //!   supports and the lever act away from the cracked end, and the cracked faces have contact).
 //!
+//! * `dcb_hartlen_large_rotation_population`: the Hartlen population above with large rotations
+//!   (co-rotational arms, solved on the whole mesh).
+//!
 //! * `dcb_2d_paper_10mm`: the same DCB on the continuum model (`dcb_2d`, 0.1 mm interface
 //!   elements, 4 Gauss points each, band LU) to 10 mm opening: the mesh its convergence check
 //!   accepts (see the book's "Beam or continuum?" chapter).
@@ -80,6 +83,19 @@ fn forward(c: &mut Criterion) {
     let mixed = Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).unwrap();
     g.bench_function("mmb_hartlen_half_mode_two", |b| b.iter(|| mmb.simulate(&mixed).unwrap()));
     g.finish();
+    // Large rotations: the co-rotational beams run on the whole mesh, some 0.3 s a run.
+    let mut large = c.benchmark_group("forward_large_rotation");
+    large.sample_size(10);
+    let mut hartlen_large = Dcb::hartlen_dcb01();
+    hartlen_large.effects.large_rotation = true;
+    let mut k = 0;
+    large.bench_function("dcb_hartlen_large_rotation_population", |b| {
+        b.iter(|| {
+            k = (k + 1) % hartlen_laws.len();
+            hartlen_large.simulate(hartlen_laws[k].as_ref()).unwrap()
+        })
+    });
+    large.finish();
     let mut slow = c.benchmark_group("forward_continuum");
     slow.sample_size(10);
     let mut continuum = Dcb2d::paper();

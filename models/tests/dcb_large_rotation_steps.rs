@@ -50,7 +50,8 @@ fn large_rotation_runs_take_about_one_step_per_output() {
         // 100 outputs: a few more steps where the crack starts; 294 steps of 7.8 assemblies each
         // on DCB-01 when the axial displacements were translated too.
         assert!(stats.steps <= 130, "{name}: {} steps for 100 outputs", stats.steps);
-        assert!(per_step <= 6.0, "{name}: {per_step:.2} assemblies per step");
+        // 4.3–4.5 with the axial predictor (`fe::path`), 4.9 before it.
+        assert!(per_step <= 5.0, "{name}: {per_step:.2} assemblies per step");
     }
 }
 
