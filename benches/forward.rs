@@ -83,7 +83,7 @@ fn forward(c: &mut Criterion) {
     let mixed = Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).unwrap();
     g.bench_function("mmb_hartlen_half_mode_two", |b| b.iter(|| mmb.simulate(&mixed).unwrap()));
     g.finish();
-    // Large rotations: the co-rotational beams run on the whole mesh, some 0.3 s a run.
+    // Large rotations: the co-rotational beams run on the whole mesh, 0.3–0.6 s a run.
     let mut large = c.benchmark_group("forward_large_rotation");
     large.sample_size(10);
     let mut hartlen_large = Dcb::hartlen_dcb01();
