@@ -89,8 +89,11 @@ pub struct Dcb {
 const OWNER: &str = "model dcb";
 
 /// The engine's choices for DCB runs: segment integration of the interface (smooth crack growth,
-/// see [`crate::fe::segment`]) and records on the output grid.
-const RUN: fe::RunOptions = fe::RunOptions { interface: fe::InterfaceRule::Segments, outputs_only: true, window: true };
+/// see [`crate::fe::segment`]), records on the output grid, the window around the crack front,
+/// and under large rotations the whole mesh cut far ahead of the front.
+pub const RUN_OPTIONS: fe::RunOptions = RUN;
+const RUN: fe::RunOptions =
+    fe::RunOptions { interface: fe::InterfaceRule::Segments, outputs_only: true, window: true, cut_far_field: true };
 
 impl Dcb {
     /// The DCB of Shi & Zhang (l = 180, b = 20, a0 = 50, 2h = 3.24 mm; E11 = 130, E22 = 6.5,
@@ -389,9 +392,15 @@ impl ForwardModel for Dcb {
 
 /// Runs `dcb` and also returns the engine's statistics (steps, iterations, factorisations).
 pub fn simulate_with_stats(dcb: &Dcb, law: &dyn CohesiveLaw) -> Result<(Record, fe::RunStats)> {
+    simulate_with_options(dcb, law, &RUN)
+}
+
+/// [`simulate_with_stats`] with the engine's run options `run` instead of the model's
+/// ([`RUN_OPTIONS`]), e.g. to check one of its shortcuts against the run without it.
+pub fn simulate_with_options(dcb: &Dcb, law: &dyn CohesiveLaw, run: &fe::RunOptions) -> Result<(Record, fe::RunStats)> {
     law.validate()?;
     dcb.effects.check_root_compliance("dcb", law)?;
     let (p, scale) = dcb.problem()?;
     let path = dcb.path(law, &scale);
-    beamtest::run(&p, law, &path, &RUN, &scale).map_err(|f| f.error)
+    beamtest::run(&p, law, &path, run, &scale).map_err(|f| f.error)
 }

@@ -182,7 +182,7 @@ fn windowed_solution_equals_the_whole_mesh_solution() {
         let mut path = paper_path(arm_deflection, 30);
         path.crack_origin = d.a0;
         let run = |window: bool| {
-            let o = RunOptions { interface: InterfaceRule::Segments, outputs_only: true, window };
+            let o = RunOptions { interface: InterfaceRule::Segments, outputs_only: true, window, cut_far_field: false };
             fe::run_with(&p, law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error))
         };
         let ((whole, sw), (win, sv)) = (run(false), run(true));
@@ -249,7 +249,7 @@ fn debonded_length_follows_the_damage_threshold() {
         let mut path = paper_path(2.0, 20);
         path.crack_origin = d.a0;
         path.damage_threshold = threshold;
-        let o = RunOptions { interface: InterfaceRule::Segments, outputs_only: true, window };
+        let o = RunOptions { interface: InterfaceRule::Segments, outputs_only: true, window, cut_far_field: false };
         fe::run_with(&p, &law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error)).0
     };
     let (full, half, half_whole) = (run(1.0 - 1e-9, true), run(0.5, true), run(0.5, false));

@@ -60,6 +60,8 @@ pub struct FeProblem {
 
 struct Element {
     layer: usize,
+    /// Its left node.
+    node: usize,
     dofs: [usize; 6],
     x1: f64,
     x2: f64,
@@ -115,6 +117,10 @@ pub struct Assembler {
     n: usize,
     strength: [f64; 2],
     hess: Box<interface::Hessian>,
+    /// Nodes from this one on are left out (at rest, their unknowns not solved for, see
+    /// [`super::newton::Newton::active`]): only the elements, points and segments of the nodes
+    /// before it are assembled, the structure cut there. `usize::MAX`: none.
+    pub frozen_from_node: usize,
 }
 
 /// Relative margin within which a cohesive point iterates with its loading-branch tangent.
@@ -145,6 +151,7 @@ impl Assembler {
                 let b = mesh.dofs(k, i + 1);
                 elements.push(Element {
                     layer: k,
+                    node: i,
                     dofs: [a[0], a[1], a[2], b[0], b[1], b[2]],
                     x1: mesh.x[i],
                     x2: mesh.x[i + 1],
@@ -191,6 +198,7 @@ impl Assembler {
             n,
             strength,
             hess: Box::new([[[0.0; 8]; 8]; 2]),
+            frozen_from_node: usize::MAX,
         }
     }
 
@@ -228,7 +236,7 @@ impl Assembler {
             self.linear.mul_vec(q, f);
         }
         if p.large_rotation {
-            for e in &self.elements {
+            for e in self.elements.iter().filter(|e| e.node + 1 < self.frozen_from_node) {
                 let mut qe = [0.0; 6];
                 for (v, &d) in qe.iter_mut().zip(&e.dofs) {
                     *v = get(q, d);
@@ -245,6 +253,10 @@ impl Assembler {
         }
         let mut ok = true;
         for (ip, pt) in p.points.iter().enumerate() {
+            if pt.node >= self.frozen_from_node {
+                // At rest beyond the solved part, with its results at rest.
+                continue;
+            }
             // A point integrated through its segments keeps its Hessians for them; the others
             // use them at once.
             let hess =
@@ -313,6 +325,9 @@ impl Assembler {
             }
         }
         for (is, sg) in self.segments.iter().enumerate() {
+            if p.points[sg.b].node >= self.frozen_from_node {
+                continue;
+            }
             let end = |i: usize| End {
                 gap: self.gaps[i],
                 t: self.trial[i].traction,

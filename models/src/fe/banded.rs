@@ -74,6 +74,14 @@ impl BandMatrix {
         self.n
     }
 
+    /// Restricts factorisations and solves to the leading `m` unknowns (at most the order the
+    /// matrix was made with): the rest are held, their couplings to the first `m` ignored. The
+    /// storage keeps its size, so [`BandMatrix::set_order`] back to the full order restores it.
+    pub fn set_order(&mut self, m: usize) {
+        assert!(m >= 1 && m * self.width <= self.data.len(), "order {m} beyond the storage");
+        self.n = m;
+    }
+
     /// Half-bandwidth.
     pub fn bandwidth(&self) -> usize {
         self.bw

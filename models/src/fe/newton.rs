@@ -50,6 +50,11 @@ pub struct Newton {
     /// Under displacement control, halve a correction that increased the residual and iterate
     /// with secant stiffnesses for a while (on by default).
     pub safeguard: bool,
+    /// Unknowns solved for: the first `active`; the others are left out (see
+    /// [`Assembler::frozen_from_node`]). All of them by default.
+    pub active: usize,
+    /// First node left out (`usize::MAX`: none); set with `active`.
+    pub frozen_from_node: usize,
 }
 
 impl Newton {
@@ -76,6 +81,8 @@ impl Newton {
             settings,
             counters: (0, 0),
             safeguard: true,
+            active: n,
+            frozen_from_node: usize::MAX,
         }
     }
 
@@ -88,6 +95,7 @@ impl Newton {
         secant: bool,
     ) -> Result<(), StepFailure> {
         self.counters.0 += 1;
+        self.asm.frozen_from_node = self.frozen_from_node;
         if self.asm.assemble(p, law, states, q, &mut self.k, &mut self.f, secant) {
             Ok(())
         } else {
@@ -125,7 +133,7 @@ impl Newton {
             let tol = self.settings.tolerance * self.scale();
             let mut rmax = 0.0f64;
             for i in 0..q.len() {
-                let v = if self.fixed_mask[i] || i == p.control { 0.0 } else { self.f[i] };
+                let v = if self.fixed_mask[i] || i == p.control || i >= self.active { 0.0 } else { self.f[i] };
                 self.r[i] = -v;
                 rmax = rmax.max(v.abs());
             }
@@ -158,8 +166,14 @@ impl Newton {
             }
             self.k.set_identity_row_col(p.control);
             self.counters.1 += 1;
-            self.k.factorize().map_err(|_| StepFailure::Singular)?;
-            self.k.solve_in_place(&mut self.r);
+            let n = self.k.n();
+            self.k.set_order(self.active);
+            let factorized = self.k.factorize();
+            if factorized.is_ok() {
+                self.k.solve_in_place(&mut self.r);
+            }
+            self.k.set_order(n);
+            factorized.map_err(|_| StepFailure::Singular)?;
             let (mut dmax, mut qmax) = (0.0f64, 0.0f64);
             for ((qi, di), bi) in q.iter_mut().zip(&self.r).zip(self.b.iter_mut()) {
                 *qi += di;
@@ -194,7 +208,7 @@ impl Newton {
             let tol = self.settings.tolerance * self.scale();
             let mut rmax = 0.0f64;
             for i in 0..q.len() {
-                let mut v = if self.fixed_mask[i] { 0.0 } else { self.f[i] };
+                let mut v = if self.fixed_mask[i] || i >= self.active { 0.0 } else { self.f[i] };
                 if i == ic {
                     v -= *lambda;
                 }
@@ -215,10 +229,16 @@ impl Newton {
                 self.k.set_identity_row_col(d);
             }
             self.counters.1 += 1;
-            self.k.factorize().map_err(|_| StepFailure::Singular)?;
             self.b.fill(0.0);
             self.b[ic] = 1.0;
-            self.k.solve2_in_place(&mut self.r, &mut self.b);
+            let n = self.k.n();
+            self.k.set_order(self.active);
+            let factorized = self.k.factorize();
+            if factorized.is_ok() {
+                self.k.solve2_in_place(&mut self.r, &mut self.b);
+            }
+            self.k.set_order(n);
+            factorized.map_err(|_| StepFailure::Singular)?;
             // Bordering: Δq = a + Δλ b, with the constraint linearised in (c, λ).
             let den = 0.5 * lambda0 * self.b[ic] - 0.5 * c0;
             if den == 0.0 || !den.is_finite() {

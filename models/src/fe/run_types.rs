@@ -97,6 +97,10 @@ pub struct RunOptions {
     /// other problem, or a run whose checks fail, is solved on the whole mesh. Records the output
     /// abscissae only.
     pub window: bool,
+    /// Under large rotations, leave the intact part far ahead of the crack front out of the
+    /// whole-mesh solve (`fe::path`'s cut: 25 decay lengths of the arm on its interface ahead of
+    /// the front, where the deflection has fallen to e⁻²⁵ of its value there).
+    pub cut_far_field: bool,
 }
 
 /// The most advanced onset front of the segment rule over the last two commits, for predicting
