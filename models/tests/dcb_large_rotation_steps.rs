@@ -132,9 +132,9 @@ fn cutting_the_far_intact_part_leaves_the_large_rotation_records_unchanged() {
             cut.1.assemblies, whole.1.assemblies
         );
         assert_eq!(pw.len(), pc.len());
-        // The cut sits where the deflection has decayed to a fraction e⁻²⁵ of its value at the
-        // front: what is left is Newton's tolerance (10⁻⁹ of the forces), far inside the 0.1 %
-        // allowed a coarsened large-rotation solve.
+        // The cut sits 25 decay lengths ahead of the onset front, where the deflection has all
+        // but vanished: what is left is Newton's tolerance (10⁻⁹ of the forces), far inside the
+        // 0.1 % a coarser large-rotation solve may differ by (the test above).
         assert!(load <= 1e-7, "{name}: loads differ by {load:.2e} of the peak");
         assert!(length <= 1e-5, "{name}: debonded lengths differ by {length:.2e} mm");
         assert!(energy <= 1e-7, "{name}: elastic energies differ by {energy:.2e}");
