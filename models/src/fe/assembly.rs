@@ -34,6 +34,23 @@ pub struct Spring {
     pub ci: f64,
 }
 
+impl Spring {
+    /// Its elongation `c_i q_i − q_j` (mm).
+    fn elongation(&self, q: &[f64]) -> f64 {
+        self.ci * q[self.i] - get(q, self.j)
+    }
+
+    /// Adds its stiffness to `k`.
+    fn stiffness_into(&self, k: &mut BandMatrix) {
+        k.add(self.i, self.i, self.k * self.ci * self.ci);
+        if self.j != NONE {
+            k.add(self.j, self.j, self.k);
+            k.add(self.i, self.j, -self.k * self.ci);
+            k.add(self.j, self.i, -self.k * self.ci);
+        }
+    }
+}
+
 /// Everything the solver needs to know about a discretised test.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FeProblem {
@@ -167,12 +184,7 @@ impl Assembler {
             }
         }
         for s in &p.springs {
-            linear.add(s.i, s.i, s.k * s.ci * s.ci);
-            if s.j != NONE {
-                linear.add(s.j, s.j, s.k);
-                linear.add(s.i, s.j, -s.k * s.ci);
-                linear.add(s.j, s.i, -s.k * s.ci);
-            }
+            s.stiffness_into(&mut linear);
         }
         let np = p.points.len();
         let zero = LawEval { traction: Default::default(), tangent: Default::default(), state: LawState::default() };
@@ -221,15 +233,12 @@ impl Assembler {
             k.clear();
             f.fill(0.0);
             for s in &p.springs {
-                let e = s.ci * q[s.i] - get(q, s.j);
+                let e = s.elongation(q);
                 f[s.i] += s.k * s.ci * e;
-                k.add(s.i, s.i, s.k * s.ci * s.ci);
                 if s.j != NONE {
                     f[s.j] -= s.k * e;
-                    k.add(s.j, s.j, s.k);
-                    k.add(s.i, s.j, -s.k * s.ci);
-                    k.add(s.j, s.i, -s.k * s.ci);
                 }
+                s.stiffness_into(k);
             }
         } else {
             k.copy_from(&self.linear);
@@ -381,7 +390,7 @@ impl Assembler {
             };
         }
         for s in &p.springs {
-            let d = s.ci * q[s.i] - get(q, s.j);
+            let d = s.elongation(q);
             e += 0.5 * s.k * d * d;
         }
         e
