@@ -377,7 +377,14 @@ fn run_identify(
     if res.partial {
         println!("interrupted: best so far in {}; continue with --resume", dir.file("result.partial.json").display());
     }
-    println!("objective f = {:.4e} after {} evaluations in {:.1} s", res.objective, res.evaluations, res.wall_seconds);
+    let repeated = match res.repeated_evaluations {
+        0 => String::new(),
+        n => format!(" ({n} of them points evaluated before, not run again)"),
+    };
+    println!(
+        "objective f = {:.4e} after {} evaluations{repeated} in {:.1} s",
+        res.objective, res.evaluations, res.wall_seconds
+    );
     for (path, p) in &res.parameters {
         println!("  {path:<28} = {:>12.6e} {:<8} {}", p.value, p.unit, p.verdict);
     }

@@ -168,6 +168,10 @@ pub struct OptimizationResult {
     pub evaluations: usize,
     /// Evaluations that failed.
     pub failures: usize,
+    /// Evaluations of a point evaluated before, answered from that evaluation instead of running
+    /// the problem again (counted in `evaluations`; a genetic algorithm's child equal to a member).
+    #[serde(default)]
+    pub repeats: usize,
     /// Every improvement of the best value: `(evaluations so far, best value)`, where the
     /// count includes the evaluation that found it (so the best-so-far curve is exact per
     /// evaluation); the last entry is `(evaluations, best.value)`.

@@ -3,6 +3,7 @@
 
 use czid_core::{Evaluation, Problem, Result};
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
 
 /// Isight's default "failed run objective value": what a failed evaluation scores.
 pub const DEFAULT_FAILED_VALUE: f64 = 1e30;
@@ -14,6 +15,9 @@ pub struct Tracker {
     pub evaluations: usize,
     /// Evaluations that failed (error or non-finite value).
     pub failures: usize,
+    /// Evaluations answered from an earlier evaluation of the same point ([`evaluate_batch_reusing`]).
+    #[serde(default)]
+    pub repeats: usize,
     /// Best point so far (empty before the first evaluation).
     pub best_x: Vec<f64>,
     /// Its evaluation.
@@ -60,6 +64,7 @@ impl Tracker {
             best,
             evaluations: self.evaluations,
             failures: self.failures,
+            repeats: self.repeats,
             history,
             pareto,
         }
@@ -97,6 +102,55 @@ pub fn evaluate_batch(
             e
         })
         .collect()
+}
+
+/// Values of points a method may generate again, by the bits of their coordinates ([`key`]).
+pub type Known = HashMap<Vec<u64>, f64>;
+
+/// The key of `x` in [`Known`]: its coordinates' bit patterns (equal keys, equal points).
+pub fn key(x: &[f64]) -> Vec<u64> {
+    x.iter().map(|v| v.to_bits()).collect()
+}
+
+/// [`evaluate_batch`] for a single-objective method that generates the same point again (a
+/// binary-coded genetic algorithm's child that no cut or mutation changed is a copy of a member):
+/// a point whose value `known` holds, or that equals an earlier point of the batch, is recorded
+/// with that value instead of being run again (the problem is deterministic, so running it again
+/// would give the same). It still counts as an evaluation, and in [`Tracker::repeats`]; a known
+/// value equal to `failed_value` counts as a failure, as it did when it was first evaluated. The
+/// evaluation returned for a known point carries its value only.
+pub fn evaluate_batch_reusing(
+    problem: &dyn Problem,
+    xs: &[Vec<f64>],
+    failed_value: f64,
+    tracker: &mut Tracker,
+    known: &Known,
+) -> Vec<Evaluation> {
+    let m = problem.objectives();
+    let keys: Vec<Vec<u64>> = xs.iter().map(|x| key(x)).collect();
+    let mut first: HashMap<&[u64], usize> = HashMap::new();
+    let fresh: Vec<usize> =
+        (0..xs.len()).filter(|&k| !known.contains_key(&keys[k]) && *first.entry(&keys[k]).or_insert(k) == k).collect();
+    let fresh_xs: Vec<Vec<f64>> = fresh.iter().map(|&k| xs[k].clone()).collect();
+    let mut computed = problem.evaluate_batch(&fresh_xs).into_iter();
+    let mut out: Vec<(Evaluation, bool)> = Vec::with_capacity(xs.len());
+    for (k, x) in xs.iter().enumerate() {
+        let (e, failed) = if let Some(&v) = known.get(&keys[k]) {
+            tracker.repeats += 1;
+            (Evaluation::scalar(v), v == failed_value)
+        } else if first[keys[k].as_slice()] != k {
+            tracker.repeats += 1;
+            out[first[keys[k].as_slice()]].clone()
+        } else {
+            match computed.next().expect("one result per fresh point") {
+                Ok(e) if is_valid(&e, m) => (e, false),
+                _ => (failed_evaluation(failed_value, m), true),
+            }
+        };
+        tracker.record(x, &e, failed);
+        out.push((e, failed));
+    }
+    out.into_iter().map(|(e, _)| e).collect()
 }
 
 fn is_valid(e: &Evaluation, m: usize) -> bool {
@@ -213,5 +267,58 @@ pub mod check {
         } else {
             Err(CzError::invalid(owner, name, value, "must be a finite number"))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use czid_core::CzError;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// `x₀² + x₁`, failing for `x₀ > 1`; counts its runs.
+    struct Counted(AtomicUsize);
+
+    impl Problem for Counted {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn bounds(&self) -> Vec<(f64, f64)> {
+            vec![(-2.0, 2.0); 2]
+        }
+        fn evaluate(&self, x: &[f64]) -> Result<Evaluation> {
+            self.0.fetch_add(1, Ordering::Relaxed);
+            if x[0] > 1.0 {
+                return Err(CzError::Simulation("diverged".into()));
+            }
+            Ok(Evaluation::scalar(x[0] * x[0] + x[1]))
+        }
+    }
+
+    #[test]
+    fn reused_evaluations_record_what_running_them_again_records() {
+        let p = Counted(AtomicUsize::new(0));
+        let first: Vec<Vec<f64>> = vec![vec![0.5, 0.1], vec![1.5, 0.0], vec![-0.2, 0.3]];
+        // Repeats of the first batch (a failure among them), and a point twice within the batch.
+        let second: Vec<Vec<f64>> =
+            vec![vec![0.5, 0.1], vec![0.1, -0.4], vec![1.5, 0.0], vec![0.1, -0.4], vec![-0.2, 0.3], vec![0.0, 0.0]];
+        let (mut plain, mut reusing) = (Tracker::default(), Tracker::default());
+        let a1 = evaluate_batch(&p, &first, 1e30, &mut plain);
+        let a2 = evaluate_batch(&p, &second, 1e30, &mut plain);
+        let runs_plain = p.0.swap(0, Ordering::Relaxed);
+        let b1 = evaluate_batch_reusing(&p, &first, 1e30, &mut reusing, &Known::new());
+        // What a population holding the first batch's points knows.
+        let known: Known = first.iter().zip(&b1).map(|(x, e)| (key(x), e.value)).collect();
+        let b2 = evaluate_batch_reusing(&p, &second, 1e30, &mut reusing, &known);
+        let runs_reusing = p.0.load(Ordering::Relaxed);
+        let values = |v: &[Evaluation]| v.iter().map(|e| e.value.to_bits()).collect::<Vec<_>>();
+        assert_eq!(values(&a1), values(&b1));
+        assert_eq!(values(&a2), values(&b2));
+        assert_eq!((runs_plain, runs_reusing), (9, 5));
+        assert_eq!(reusing.repeats, 4);
+        assert_eq!((reusing.evaluations, reusing.failures), (plain.evaluations, plain.failures));
+        assert_eq!(reusing.failures, 2);
+        assert_eq!((reusing.best_x.clone(), reusing.best.clone()), (plain.best_x.clone(), plain.best.clone()));
+        assert_eq!(reusing.history, plain.history);
     }
 }

@@ -189,6 +189,7 @@ impl Hybrid {
         }
         g.evaluations = total;
         g.failures += local.failures;
+        g.repeats += local.repeats;
         Ok(g)
     }
 }

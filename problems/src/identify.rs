@@ -101,6 +101,10 @@ pub struct IdentifyResult {
     pub evaluations: usize,
     /// Evaluations whose simulation failed.
     pub failed_evaluations: usize,
+    /// Evaluations of a point evaluated before, answered without running it again (a genetic
+    /// algorithm's child equal to a member).
+    #[serde(default)]
+    pub repeated_evaluations: usize,
     /// Wall time of the optimisation (s).
     pub wall_seconds: f64,
     /// Share of the run's CPU time (wall time × worker threads) spent in forward simulations.
@@ -445,6 +449,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         rms_error: errors.into_iter().collect(),
         evaluations: result.evaluations,
         failed_evaluations: result.failures,
+        repeated_evaluations: result.repeats,
         wall_seconds: wall,
         forward_share: forward_seconds / (run.wall_seconds.max(1e-12) * rayon::current_num_threads() as f64),
         resumed: clock.resumed(),

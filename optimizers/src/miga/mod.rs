@@ -22,7 +22,7 @@ pub use migration::{EmigrantPolicy, ReplacementPolicy};
 pub use topology::Topology;
 
 use crate::encoding::{Codec, Encoding};
-use crate::eval::{self, check, evaluate_batch, Tracker, DEFAULT_FAILED_VALUE};
+use crate::eval::{self, check, evaluate_batch, evaluate_batch_reusing, Known, Tracker, DEFAULT_FAILED_VALUE};
 use czid_core::{Budget, CzError, Observer, OptimizationResult, Optimizer, Problem, Result, Snapshot};
 use island::{breed, ranked, Operators};
 use rand::{Rng, SeedableRng};
@@ -196,6 +196,9 @@ impl Miga {
         let mut genes = Vec::with_capacity(per_generation);
         let mut xs: Vec<Vec<f64>> = Vec::with_capacity(per_generation);
         let mut order = Vec::with_capacity(s.sub_population);
+        // The values of the population's members: late in a run about one child in ten is a copy
+        // of one of them (a member crossed with itself, no bit mutated), and is not run again.
+        let mut known = Known::new();
         while !state.tracker.target_reached(budget) && state.tracker.evaluations + per_generation <= budget.evaluations
         {
             genes.clear();
@@ -206,7 +209,9 @@ impl Miga {
             for (g, x) in genes.iter().zip(xs.iter_mut()) {
                 codec.decode_into(g, x);
             }
-            let values = evaluate_batch(problem, &xs, s.failed_value, &mut state.tracker);
+            known.clear();
+            known.extend(state.islands.iter().flatten().map(|m| (eval::key(&m.x), m.value)));
+            let values = evaluate_batch_reusing(problem, &xs, s.failed_value, &mut state.tracker, &known);
             let mut children = genes.drain(..).zip(xs.iter()).zip(values);
             for island in state.islands.iter_mut() {
                 ranked(island, &mut order);
