@@ -172,13 +172,20 @@ pub(crate) fn path_work_split(
     bp[n] = 1.0;
     bp[1..n].sort_by(f64::total_cmp);
     let (mut w, mut ws) = (0.0, 0.0);
+    // The traction at the end of a piece is the next piece's start (evaluated once).
+    let mut carried: Option<(f64, Traction)> = None;
     for k in 0..n {
         let (a, b) = (bp[k], bp[k + 1]);
         if b <= a {
             continue;
         }
-        let ta = if a == 0.0 { t0 } else { traction(a) };
+        let ta = match carried {
+            Some((at, t)) if at == a => t,
+            _ if a == 0.0 => t0,
+            _ => traction(a),
+        };
         let tb = if b == 1.0 { t1 } else { traction(b) };
+        carried = Some((b, tb));
         let tm = traction(0.5 * (a + b));
         let simpson = ta + tm * 4.0 + tb;
         w += (b - a) / 6.0 * simpson.dot(&dg);
