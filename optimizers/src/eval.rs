@@ -94,10 +94,7 @@ pub fn evaluate_batch(
     raw.into_iter()
         .zip(xs)
         .map(|(r, x)| {
-            let (e, failed) = match r {
-                Ok(e) if is_valid(&e, m) => (e, false),
-                _ => (failed_evaluation(failed_value, m), true),
-            };
+            let (e, failed) = judged(r, m, failed_value);
             tracker.record(x, &e, failed);
             e
         })
@@ -142,15 +139,21 @@ pub fn evaluate_batch_reusing(
             tracker.repeats += 1;
             out[first[keys[k].as_slice()]].clone()
         } else {
-            match computed.next().expect("one result per fresh point") {
-                Ok(e) if is_valid(&e, m) => (e, false),
-                _ => (failed_evaluation(failed_value, m), true),
-            }
+            judged(computed.next().expect("one result per fresh point"), m, failed_value)
         };
         tracker.record(x, &e, failed);
         out.push((e, failed));
     }
     out.into_iter().map(|(e, _)| e).collect()
+}
+
+/// A problem's answer as recorded: the evaluation and `false`, or the penalised stand-in and
+/// `true` for a failure.
+fn judged(r: Result<Evaluation>, m: usize, failed_value: f64) -> (Evaluation, bool) {
+    match r {
+        Ok(e) if is_valid(&e, m) => (e, false),
+        _ => (failed_evaluation(failed_value, m), true),
+    }
 }
 
 fn is_valid(e: &Evaluation, m: usize) -> bool {

@@ -143,7 +143,7 @@ impl Problem for Journal<'_> {
     /// The candidates the journal holds are served from it; the others go to the wrapped problem
     /// as one batch and are journaled.
     fn evaluate_batch(&self, xs: &[Vec<f64>]) -> Vec<Result<Evaluation>> {
-        let keys: Vec<Vec<u64>> = xs.iter().map(|x| x.iter().map(|v| v.to_bits()).collect()).collect();
+        let keys: Vec<Vec<u64>> = xs.iter().map(|x| crate::eval::key(x)).collect();
         let fresh: Vec<usize> = (0..xs.len()).filter(|&k| !self.known.contains_key(&keys[k])).collect();
         let fresh_xs: Vec<Vec<f64>> = fresh.iter().map(|&k| xs[k].clone()).collect();
         let mut computed = self.inner.evaluate_batch(&fresh_xs).into_iter();

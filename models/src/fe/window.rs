@@ -538,6 +538,28 @@ struct PointRecord {
     g: Gap,
 }
 
+impl PointRecord {
+    /// Moves the point to the gap `g1` and the law's evaluation `ev` there, from the committed
+    /// state `before`: the work over the step is integrated along the gap path by the law where
+    /// the state changed (as [`super::energy::Ledger::commit_along`]), by the trapezoidal rule
+    /// where it did not.
+    fn commit(&mut self, law: &dyn CohesiveLaw, mode_one: &ModeOne, before: &LawState, g1: Gap, ev: &LawEval) {
+        self.work += if ev.state != *before {
+            path_work(law, before, (self.g, self.t), (g1, ev.traction), &ev.state, Some(mode_one))
+        } else {
+            0.5 * (self.t + ev.traction).dot(&(g1 - self.g))
+        };
+        self.t = ev.traction;
+        self.g = g1;
+        self.state = ev.state;
+    }
+
+    /// Energy per unit area the point has dissipated: the work done on it less what it stores.
+    fn dissipated(&self, law: &dyn CohesiveLaw) -> f64 {
+        self.work - law.stored_energy(&self.g, &self.state)
+    }
+}
+
 /// Solves `p` along `s` with the window; the rows at the output abscissae.
 pub(crate) fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Vec<StepRow>, RunStats), Unfit> {
     run_condensing(p, law, s, CONDENSE_OPENING)
@@ -1229,10 +1251,8 @@ impl<'a, const D: usize> Solver<'a, D> {
     /// energy their points dissipated.
     fn shrink_left(&mut self, new_i0: usize) -> Result<(), Unfit> {
         for j in self.i0..new_i0 {
-            let pi = self.lay.cp(j).point;
-            let r = &self.pts[pi];
-            let psi = self.law.stored_energy(&r.g, &r.state);
-            self.frozen += self.lay.cp(j).weight * (r.work - psi);
+            let cp = self.lay.cp(j);
+            self.frozen += cp.weight * self.pts[cp.point].dissipated(self.law);
         }
         self.advance_left(new_i0)
     }
@@ -1242,18 +1262,7 @@ impl<'a, const D: usize> Solver<'a, D> {
     fn commit_points(&mut self, before: &[LawState]) {
         for j in self.i0..=self.i1 {
             let pi = self.lay.cp(j).point;
-            let ev = &self.ev[pi];
-            let g1 = self.gaps[pi];
-            let r = &mut self.pts[pi];
-            let dw = if ev.state != before[pi] {
-                path_work(self.law, &before[pi], (r.g, r.t), (g1, ev.traction), &ev.state, Some(&self.mode_one))
-            } else {
-                0.5 * (r.t + ev.traction).dot(&(g1 - r.g))
-            };
-            r.work += dw;
-            r.t = ev.traction;
-            r.g = g1;
-            r.state = ev.state;
+            self.pts[pi].commit(self.law, &self.mode_one, &before[pi], self.gaps[pi], &self.ev[pi]);
         }
     }
 
@@ -1261,8 +1270,7 @@ impl<'a, const D: usize> Solver<'a, D> {
         let mut dissipated = self.frozen;
         for j in self.i0..=self.i1 {
             let cp = self.lay.cp(j);
-            let r = &self.pts[cp.point];
-            dissipated += cp.weight * (r.work - self.law.stored_energy(&r.g, &r.state));
+            dissipated += cp.weight * self.pts[cp.point].dissipated(self.law);
         }
         StepRow {
             control: self.c,
@@ -1359,19 +1367,9 @@ impl<'a, const D: usize> Solver<'a, D> {
         }
         for (j, g1, ev) in settled {
             let cp = self.lay.cp(j);
-            let before = &states[cp.point];
             let r = &mut self.pts[cp.point];
-            let dw = if ev.state != *before {
-                path_work(self.law, before, (r.g, r.t), (g1, ev.traction), &ev.state, Some(&self.mode_one))
-            } else {
-                0.5 * (r.t + ev.traction).dot(&(g1 - r.g))
-            };
-            r.work += dw;
-            r.t = ev.traction;
-            r.g = g1;
-            r.state = ev.state;
-            let psi = self.law.stored_energy(&r.g, &r.state);
-            self.frozen += cp.weight * (r.work - psi);
+            r.commit(self.law, &self.mode_one, &states[cp.point], g1, &ev);
+            self.frozen += cp.weight * r.dissipated(self.law);
         }
         true
     }
