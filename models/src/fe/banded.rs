@@ -15,7 +15,7 @@
 //! [`BandError::SingularPivot`] so the caller can cut the step rather than produce garbage.
 
 /// Square matrix stored by rows over the band `|i - j| <= bw`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct BandMatrix {
     n: usize,
     bw: usize,
@@ -47,6 +47,20 @@ impl BandRow<'_> {
         for (e, x) in self.entries[start..start + v.len()].iter_mut().zip(v) {
             *e += x;
         }
+    }
+}
+
+/// A matrix an assembly adds entries to: a general band ([`BandMatrix`]) or the upper band of a
+/// symmetric one ([`super::symmetric_band::SymmetricBand`]), so one element routine serves both.
+pub trait AddEntry {
+    /// Adds `v` to entry `(i, j)`, which must lie within the band.
+    fn add(&mut self, i: usize, j: usize, v: f64);
+}
+
+impl AddEntry for BandMatrix {
+    #[inline]
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        BandMatrix::add(self, i, j, v);
     }
 }
 

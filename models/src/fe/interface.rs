@@ -103,11 +103,30 @@ fn surface(q: &[f64], dofs: &[usize; 4], z: f64, large: bool) -> Surface {
         r.d2p[1][2][3] = -sn;
         r.d2p[1][3][2] = -sn;
     } else {
-        r.p = [u - z * t, w + s];
+        r.p = surface_position(q, dofs, z);
         r.dp[0] = [1.0, 0.0, -z, 0.0];
         r.dp[1] = [0.0, 1.0, 0.0, 1.0];
     }
     r
+}
+
+/// The gap `[g_n, g_t]` of point `p` at `q` under small rotations, the same numbers as
+/// [`kinematics`] gives without its gradient (which is then constant: a solver keeps it once).
+pub fn small_gap(mesh: &Mesh, p: &InterfacePoint, q: &[f64]) -> [f64; 2] {
+    let du = mesh.dofs(p.upper, p.node);
+    let su = surface_position(q, &du, -0.5 * mesh.layers[p.upper].section.h);
+    let Some(lo) = p.lower else {
+        return [2.0 * su[1], 0.0];
+    };
+    let sl = surface_position(q, &mesh.dofs(lo, p.node), 0.5 * mesh.layers[lo].section.h);
+    [su[1] - sl[1], su[0] - sl[0]]
+}
+
+/// [`surface`]'s displacement alone, small rotations.
+#[inline]
+fn surface_position(q: &[f64], dofs: &[usize; 4], z: f64) -> [f64; 2] {
+    let (u, w, t, s) = (val(q, dofs[0]), val(q, dofs[1]), val(q, dofs[2]), val(q, dofs[3]));
+    [u - z * t, w + s]
 }
 
 /// Gap kinematics of point `p` at unknowns `q`; with `large`, also the Hessians into `hess`

@@ -46,7 +46,7 @@
 use czid_core::{CohesiveLaw, CzError, Gap, LawEval, LawState, Tangent, Traction};
 
 use super::assembly::{loading_tangent, strengths, Spring};
-use super::banded::{BandMatrix, RowSparse};
+use super::banded::{AddEntry, BandError, BandMatrix, RowSparse};
 use super::beam;
 use super::crack::{self, CrackMeasures};
 use super::energy::path_work;
@@ -55,6 +55,7 @@ use super::interface::{self, InterfacePoint, PointKind};
 use super::mesh::{Mesh, NONE};
 use super::newton::NewtonSettings;
 use super::segment;
+use super::symmetric_band::SymmetricBand;
 use crate::materials::UniaxialState;
 
 /// Fraction of the initial normal stiffness a failed interface point keeps in opening under
@@ -221,7 +222,6 @@ struct Base {
 }
 
 /// Committed or trial state of everything with history.
-#[derive(Clone)]
 struct History {
     points: Vec<LawState>,
     law_gaps: Vec<Gap>,
@@ -230,6 +230,31 @@ struct History {
     fibres: Vec<UniaxialState>,
     strains: Vec<f64>,
     stresses: Vec<f64>,
+}
+
+impl Clone for History {
+    fn clone(&self) -> Self {
+        History {
+            points: self.points.clone(),
+            law_gaps: self.law_gaps.clone(),
+            tractions: self.tractions.clone(),
+            gaps: self.gaps.clone(),
+            fibres: self.fibres.clone(),
+            strains: self.strains.clone(),
+            stresses: self.stresses.clone(),
+        }
+    }
+
+    /// Field by field into the existing vectors: a step's commit allocates nothing.
+    fn clone_from(&mut self, o: &Self) {
+        self.points.clone_from(&o.points);
+        self.law_gaps.clone_from(&o.law_gaps);
+        self.tractions.clone_from(&o.tractions);
+        self.gaps.clone_from(&o.gaps);
+        self.fibres.clone_from(&o.fibres);
+        self.strains.clone_from(&o.strains);
+        self.stresses.clone_from(&o.stresses);
+    }
 }
 
 struct Solver<'a> {
@@ -242,7 +267,14 @@ struct Solver<'a> {
     linear: BandMatrix,
     /// The non-zero entries of `linear`, for its product with the unknowns.
     linear_rows: RowSparse,
+    /// `linear`'s upper band, the start of a symmetric iteration matrix.
+    linear_upper: SymmetricBand,
+    /// The iteration matrix: general, or (with extrapolated damage, where every stiffness is
+    /// symmetric) symmetric in half the storage and work; `symmetric` says which holds the
+    /// factors of the last tangent.
     k: BandMatrix,
+    ks: SymmetricBand,
+    symmetric: bool,
     f: Vec<f64>,
     fixed_mask: Vec<bool>,
     strength: [f64; 2],
@@ -286,7 +318,7 @@ fn get(q: &[f64], d: usize) -> f64 {
     }
 }
 
-fn scatter(k: &mut BandMatrix, dofs: &[usize; 6], ke: &[[f64; 6]; 6]) {
+fn scatter<K: AddEntry>(k: &mut K, dofs: &[usize; 6], ke: &[[f64; 6]; 6]) {
     for (a, &da) in dofs.iter().enumerate() {
         if da == NONE {
             continue;
@@ -420,7 +452,10 @@ impl<'a> Solver<'a> {
             fibre_elements,
             prepared: p.fibre_layers.iter().map(|fl| fl.sections.iter().map(|sec| sec.prepared()).collect()).collect(),
             k: BandMatrix::zeros(n, mesh.bandwidth()),
+            ks: SymmetricBand::zeros(n, mesh.bandwidth()),
+            symmetric: false,
             linear_rows: RowSparse::from_band(&linear),
+            linear_upper: SymmetricBand::upper_of(&linear),
             linear,
             f: vec![0.0; n],
             fixed_mask,
@@ -532,10 +567,9 @@ impl<'a> Solver<'a> {
     /// The interface points' part of [`Solver::assemble`], `ok` from the rest.
     fn assemble_interface(&mut self, c: &History, q: &[f64], secant: bool, mut ok: bool) -> bool {
         let p = self.p;
-        let mut hess = [[[0.0; 8]; 8]; 2];
-        for (ip, pt) in p.points.iter().enumerate() {
-            let kin = interface::kinematics(&p.mesh, pt, q, false, &mut hess);
-            let gap = Gap::new(kin.gap[0], kin.gap[1]);
+        for (ip, (pt, kin)) in p.points.iter().zip(&self.kinematics).enumerate() {
+            let [gn, gt] = interface::small_gap(&p.mesh, pt, q);
+            let gap = Gap::new(gn, gt);
             let state = &c.points[ip];
             let (ev, d, gl) = if let Some(dex) = &self.extrapolated {
                 // Open or closed as at the start of the step (see `correct_status`).
@@ -575,12 +609,39 @@ impl<'a> Solver<'a> {
         ok
     }
 
-    /// The tangent at the last assembly into `k`: the linear layers', the fibre elements' from
-    /// their section tangents, the interface points' from their iteration stiffnesses.
-    fn tangent(&mut self) {
-        self.k.copy_from(&self.linear);
+    /// Factorises the tangent at the last assembly, the prescribed unknowns' rows and columns
+    /// replaced by the identity's: symmetric with extrapolated damage (the interface's iteration
+    /// stiffness is then `diag((1 − D) k)`, and the layers' and fibres' are symmetric), else
+    /// general (a law's own tangent need not be symmetric).
+    fn factorize_tangent(&mut self) -> Result<(), BandError> {
+        self.stats.factorizations += 1;
+        self.symmetric = self.extrapolated.is_some();
+        if self.symmetric {
+            let mut k = std::mem::take(&mut self.ks);
+            k.copy_from(&self.linear_upper);
+            self.add_tangent(&mut k);
+            for &d in &self.p.fixed {
+                k.set_identity_row_col(d);
+            }
+            self.ks = k;
+            self.ks.factorize()
+        } else {
+            let mut k = std::mem::take(&mut self.k);
+            k.copy_from(&self.linear);
+            self.add_tangent(&mut k);
+            for &d in &self.p.fixed {
+                k.set_identity_row_col(d);
+            }
+            self.k = k;
+            self.k.factorize()
+        }
+    }
+
+    /// Adds the fibre elements' tangents (from their section tangents) and the interface points'
+    /// (from their iteration stiffnesses) at the last assembly to `k`.
+    fn add_tangent<K: AddEntry>(&self, k: &mut K) {
         for (fe, st) in self.fibre_elements.iter().zip(&self.section_tangents) {
-            fibre::scatter_tangent(fe.len, st, &fe.dofs, &mut self.k);
+            fibre::scatter_tangent(fe.len, st, &fe.dofs, k);
         }
         for ((pt, kin), d) in self.p.points.iter().zip(&self.kinematics).zip(&self.iteration_tangents) {
             let w = pt.area * pt.factor;
@@ -599,10 +660,28 @@ impl<'a> Solver<'a> {
                     }
                     let v = ra0 * g[0][b] + ra1 * g[1][b];
                     if v != 0.0 {
-                        self.k.add(da, db, w * v);
+                        k.add(da, db, w * v);
                     }
                 }
             }
+        }
+    }
+
+    /// Solves with the last factorised tangent.
+    fn solve_factored(&self, b: &mut [f64]) {
+        if self.symmetric {
+            self.ks.solve_in_place(b);
+        } else {
+            self.k.solve_in_place(b);
+        }
+    }
+
+    /// Solves for two right-hand sides with the last factorised tangent.
+    fn solve2_factored(&self, b1: &mut [f64], b2: &mut [f64]) {
+        if self.symmetric {
+            self.ks.solve2_in_place(b1, b2);
+        } else {
+            self.k.solve2_in_place(b1, b2);
         }
     }
 
@@ -794,17 +873,12 @@ impl<'a> Solver<'a> {
             // halved back towards it, spending the iterations on a point that cannot be right.
             r_prev = if cres.abs() <= 1e-9 * ctl.abs().max(1e-9) { rmax } else { f64::INFINITY };
             alpha = 1.0;
-            self.tangent();
-            for &d in &self.p.fixed {
-                self.k.set_identity_row_col(d);
-            }
-            self.stats.factorizations += 1;
-            self.k.factorize().ok()?;
+            self.factorize_tangent().ok()?;
             if c_target.is_some() {
                 for i in 0..n {
                     b[i] = if self.fixed_mask[i] { 0.0 } else { self.load[i] };
                 }
-                self.k.solve2_in_place(r, b);
+                self.solve2_factored(r, b);
                 let a1: f64 = self.p.control.iter().map(|&(d, a)| a * r[d]).sum();
                 let a2: f64 = self.p.control.iter().map(|&(d, a)| a * b[d]).sum();
                 if a2 == 0.0 || !a2.is_finite() {
@@ -817,7 +891,7 @@ impl<'a> Solver<'a> {
                 }
                 *load += dload;
             } else {
-                self.k.solve_in_place(r);
+                self.solve_factored(r);
                 dload = 0.0;
                 dq.copy_from_slice(r);
                 for (qi, ri) in q.iter_mut().zip(r.iter()) {
