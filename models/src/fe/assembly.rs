@@ -131,6 +131,9 @@ pub struct Assembler {
     mode_one: Option<ModeOne>,
     data: Vec<PointData>,
     hessians: Vec<interface::Hessian>,
+    /// Under small rotations, each point's gap kinematics at rest: its gradient holds at every
+    /// `q`, so an assembly only takes the gap. Empty under large rotations.
+    at_rest: Vec<GapKinematics>,
     n: usize,
     strength: [f64; 2],
     hess: Box<interface::Hessian>,
@@ -207,6 +210,12 @@ impl Assembler {
             mode_one,
             data: vec![PointData::default(); np],
             hessians: if large { vec![[[[0.0; 8]; 8]; 2]; np] } else { Vec::new() },
+            at_rest: if p.large_rotation {
+                Vec::new()
+            } else {
+                let (zero, mut hess) = (vec![0.0; n], [[[0.0; 8]; 8]; 2]);
+                p.points.iter().map(|pt| interface::kinematics(mesh, pt, &zero, false, &mut hess)).collect()
+            },
             n,
             strength,
             hess: Box::new([[[0.0; 8]; 8]; 2]),
@@ -270,7 +279,10 @@ impl Assembler {
             // use them at once.
             let hess =
                 if self.covered[ip] && !self.hessians.is_empty() { &mut self.hessians[ip] } else { &mut *self.hess };
-            let kin = interface::kinematics(&p.mesh, pt, q, p.large_rotation, hess);
+            let kin = match self.at_rest.get(ip) {
+                Some(rest) => GapKinematics { gap: interface::small_gap(&p.mesh, pt, q), ..*rest },
+                None => interface::kinematics(&p.mesh, pt, q, p.large_rotation, hess),
+            };
             let gap = Gap::new(kin.gap[0], kin.gap[1]);
             let (ev, d) = match pt.kind {
                 PointKind::Cohesive => {
