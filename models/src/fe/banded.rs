@@ -50,17 +50,25 @@ impl BandRow<'_> {
     }
 }
 
-/// A matrix an assembly adds entries to: a general band ([`BandMatrix`]) or the upper band of a
-/// symmetric one ([`super::symmetric_band::SymmetricBand`]), so one element routine serves both.
-pub trait AddEntry {
+/// A band matrix an assembly writes a tangent into: a general band ([`BandMatrix`]) or the upper
+/// band of a symmetric one ([`super::symmetric_band::SymmetricBand`]), so one element routine
+/// serves both.
+pub trait StiffnessBand {
     /// Adds `v` to entry `(i, j)`, which must lie within the band.
     fn add(&mut self, i: usize, j: usize, v: f64);
+
+    /// Replaces row and column `i` by those of the identity (a prescribed unknown).
+    fn set_identity_row_col(&mut self, i: usize);
 }
 
-impl AddEntry for BandMatrix {
+impl StiffnessBand for BandMatrix {
     #[inline]
     fn add(&mut self, i: usize, j: usize, v: f64) {
         BandMatrix::add(self, i, j, v);
+    }
+
+    fn set_identity_row_col(&mut self, i: usize) {
+        BandMatrix::set_identity_row_col(self, i);
     }
 }
 

@@ -17,7 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::banded::AddEntry;
+use super::banded::StiffnessBand;
 use super::mesh::NONE;
 use crate::materials::{
     Concrete, PreparedConcrete, PreparedSteel, Steel, UniaxialMaterial, UniaxialResponse, UniaxialState,
@@ -350,7 +350,7 @@ pub fn element_forces(l: f64, s: &SectionResponse, dofs: &[usize; 6], f: &mut [f
 /// Adds the tangent `Bᵀ D B l` of [`element`] (section tangent `d`) to `k` at the element's
 /// unknowns `dofs`, only its non-zero (`u` and `θ`) entries.
 #[inline]
-pub fn scatter_tangent<K: AddEntry>(l: f64, d: &[[f64; 2]; 2], dofs: &[usize; 6], k: &mut K) {
+pub fn scatter_tangent<K: StiffnessBand>(l: f64, d: &[[f64; 2]; 2], dofs: &[usize; 6], k: &mut K) {
     let cols = b_columns(l);
     for &(a, ba, ra) in &cols {
         let da = dofs[a];

@@ -46,7 +46,7 @@
 use czid_core::{CohesiveLaw, CzError, Gap, LawEval, LawState, Tangent, Traction};
 
 use super::assembly::{loading_tangent, strengths, Spring};
-use super::banded::{AddEntry, BandError, BandMatrix, RowSparse};
+use super::banded::{BandError, BandMatrix, RowSparse, StiffnessBand};
 use super::beam;
 use super::crack::{self, CrackMeasures};
 use super::energy::path_work;
@@ -318,7 +318,7 @@ fn get(q: &[f64], d: usize) -> f64 {
     }
 }
 
-fn scatter<K: AddEntry>(k: &mut K, dofs: &[usize; 6], ke: &[[f64; 6]; 6]) {
+fn scatter<K: StiffnessBand>(k: &mut K, dofs: &[usize; 6], ke: &[[f64; 6]; 6]) {
     for (a, &da) in dofs.iter().enumerate() {
         if da == NONE {
             continue;
@@ -620,26 +620,21 @@ impl<'a> Solver<'a> {
             let mut k = std::mem::take(&mut self.ks);
             k.copy_from(&self.linear_upper);
             self.add_tangent(&mut k);
-            for &d in &self.p.fixed {
-                k.set_identity_row_col(d);
-            }
             self.ks = k;
             self.ks.factorize()
         } else {
             let mut k = std::mem::take(&mut self.k);
             k.copy_from(&self.linear);
             self.add_tangent(&mut k);
-            for &d in &self.p.fixed {
-                k.set_identity_row_col(d);
-            }
             self.k = k;
             self.k.factorize()
         }
     }
 
     /// Adds the fibre elements' tangents (from their section tangents) and the interface points'
-    /// (from their iteration stiffnesses) at the last assembly to `k`.
-    fn add_tangent<K: AddEntry>(&self, k: &mut K) {
+    /// (from their iteration stiffnesses) at the last assembly to `k`, then replaces the
+    /// prescribed unknowns' rows and columns by the identity's.
+    fn add_tangent<K: StiffnessBand>(&self, k: &mut K) {
         for (fe, st) in self.fibre_elements.iter().zip(&self.section_tangents) {
             fibre::scatter_tangent(fe.len, st, &fe.dofs, k);
         }
@@ -664,6 +659,9 @@ impl<'a> Solver<'a> {
                     }
                 }
             }
+        }
+        for &d in &self.p.fixed {
+            k.set_identity_row_col(d);
         }
     }
 

@@ -7,7 +7,7 @@
 //! ([`super::banded::BandMatrix`]): half the arithmetic and half the memory to clear and copy.
 //! Pivots are checked as there ([`BandError::SingularPivot`]).
 
-use super::banded::{AddEntry, BandError, BandMatrix};
+use super::banded::{BandError, BandMatrix, StiffnessBand};
 
 /// Symmetric `n × n` matrix stored by rows over the upper band `i ≤ j ≤ i + bw`.
 #[derive(Clone, Debug, Default)]
@@ -267,7 +267,7 @@ impl SymmetricBand {
     }
 }
 
-impl AddEntry for SymmetricBand {
+impl StiffnessBand for SymmetricBand {
     /// Adds `v` to entry `(i, j)` when `j ≥ i`. An entry below the diagonal is not stored: the
     /// caller adds a symmetric matrix, whose mirror entry `(j, i)` carries the same value.
     #[inline]
@@ -276,6 +276,10 @@ impl AddEntry for SymmetricBand {
             debug_assert!(j - i <= self.bw, "entry ({i},{j}) outside band {}", self.bw);
             self.data[i * self.width + (j - i)] += v;
         }
+    }
+
+    fn set_identity_row_col(&mut self, i: usize) {
+        SymmetricBand::set_identity_row_col(self, i);
     }
 }
 
