@@ -616,6 +616,10 @@ impl<'a> Solver<'a> {
     fn factorize_tangent(&mut self) -> Result<(), BandError> {
         self.stats.factorizations += 1;
         self.symmetric = self.extrapolated.is_some();
+        // `with_damage` gives every point a diagonal stiffness. Were one not symmetric, the
+        // iteration matrix would be wrong, not the solution (the residual is exact): Newton would
+        // only converge more slowly.
+        debug_assert!(!self.symmetric || self.iteration_tangents.iter().all(|d| d[(0, 1)] == d[(1, 0)]));
         if self.symmetric {
             let mut k = std::mem::take(&mut self.ks);
             k.copy_from(&self.linear_upper);

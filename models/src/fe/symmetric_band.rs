@@ -83,7 +83,7 @@ impl SymmetricBand {
         match self.bw {
             // Two beam layers with three unknowns per node (the FRP beam).
             11 => self.factorize_fixed::<11, 12>(),
-            _ => self.factorize_from(0),
+            _ => self.factorize_rows(0, self.pivot_floor()),
         }
     }
 
@@ -121,12 +121,6 @@ impl SymmetricBand {
             }
         }
         self.factorize_rows(inner, tiny)
-    }
-
-    /// The factorisation for any half-bandwidth (from row 0).
-    fn factorize_from(&mut self, start: usize) -> Result<(), BandError> {
-        let tiny = self.pivot_floor();
-        self.factorize_rows(start, tiny)
     }
 
     /// Rows `start..n` of the factorisation (those before done), pivots floored at `tiny`.
