@@ -209,19 +209,21 @@ struct FibreElement {
     first: usize,
 }
 
-/// The linear layers' and the fibres' part of an assembly: their forces `f` at the unknowns `q`
-/// with secant stiffnesses or not; `valid` while the committed history is that of the assembly and
-/// no fibre has taken its unloading stiffness since.
+/// The linear layers' and the fibres' part of an assembly: their forces `f` with secant
+/// stiffnesses or not; `valid` while the committed history is that of the assembly and no fibre has
+/// taken its unloading stiffness since, and `same_unknowns` when the next assembly is at the same
+/// unknowns (Newton starting again after a correction of the normal statuses).
 #[derive(Default)]
 struct Base {
     valid: bool,
     secant: bool,
     ok: bool,
-    q: Vec<f64>,
+    same_unknowns: bool,
     f: Vec<f64>,
 }
 
 /// Committed or trial state of everything with history.
+#[derive(Clone)]
 struct History {
     points: Vec<LawState>,
     law_gaps: Vec<Gap>,
@@ -230,31 +232,6 @@ struct History {
     fibres: Vec<UniaxialState>,
     strains: Vec<f64>,
     stresses: Vec<f64>,
-}
-
-impl Clone for History {
-    fn clone(&self) -> Self {
-        History {
-            points: self.points.clone(),
-            law_gaps: self.law_gaps.clone(),
-            tractions: self.tractions.clone(),
-            gaps: self.gaps.clone(),
-            fibres: self.fibres.clone(),
-            strains: self.strains.clone(),
-            stresses: self.stresses.clone(),
-        }
-    }
-
-    /// Field by field into the existing vectors: a step's commit allocates nothing.
-    fn clone_from(&mut self, o: &Self) {
-        self.points.clone_from(&o.points);
-        self.law_gaps.clone_from(&o.law_gaps);
-        self.tractions.clone_from(&o.tractions);
-        self.gaps.clone_from(&o.gaps);
-        self.fibres.clone_from(&o.fibres);
-        self.strains.clone_from(&o.strains);
-        self.stresses.clone_from(&o.stresses);
-    }
 }
 
 struct Solver<'a> {
@@ -487,7 +464,7 @@ impl<'a> Solver<'a> {
         self.stats.assemblies += 1;
         // Again at the unknowns of the last assembly (after a correction of the normal statuses):
         // the linear layers and the fibres give what they gave then.
-        if self.base.valid && self.base.secant == secant && self.base.q == q {
+        if std::mem::take(&mut self.base.same_unknowns) && self.base.valid && self.base.secant == secant {
             self.f.copy_from_slice(&self.base.f);
             return self.assemble_interface(c, q, secant, self.base.ok);
         }
@@ -557,8 +534,6 @@ impl<'a> Solver<'a> {
         base.valid = !unloading_changed;
         base.secant = secant;
         base.ok = ok;
-        base.q.clear();
-        base.q.extend_from_slice(q);
         base.f.clear();
         base.f.extend_from_slice(&self.f);
         self.assemble_interface(c, q, secant, ok)
@@ -775,6 +750,7 @@ impl<'a> Solver<'a> {
         // The work vectors are kept from one step to the next.
         // A new committed history (or a new step from it).
         self.base.valid = false;
+        self.base.same_unknowns = false;
         let mut work = std::mem::take(&mut self.work);
         work.resize_with(3, Vec::new);
         for v in work.iter_mut() {
@@ -843,6 +819,7 @@ impl<'a> Solver<'a> {
                 }
                 // A new start for the iterations with the corrected statuses.
                 corrections += 1;
+                self.base.same_unknowns = true;
                 r_prev = f64::INFINITY;
                 it = 0;
                 continue;
@@ -1166,7 +1143,9 @@ pub fn run(
                 prev_load = load;
                 q.copy_from_slice(&trial_q);
                 load = trial_load;
-                committed.clone_from(&s.trial);
+                // The trial history becomes the committed one; the old committed vectors are the
+                // next step's trial, which the step's first assembly overwrites in full.
+                std::mem::swap(&mut committed, &mut s.trial);
                 s.stats.steps += 1;
                 pos += dh;
                 h_prev = dh;
