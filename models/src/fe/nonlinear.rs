@@ -220,6 +220,9 @@ struct Base {
     ok: bool,
     same_unknowns: bool,
     f: Vec<f64>,
+    /// The unknowns of the assembly, kept in debug builds to check `same_unknowns`.
+    #[cfg(debug_assertions)]
+    q: Vec<f64>,
 }
 
 /// Committed or trial state of everything with history.
@@ -465,6 +468,8 @@ impl<'a> Solver<'a> {
         // Again at the unknowns of the last assembly (after a correction of the normal statuses):
         // the linear layers and the fibres give what they gave then.
         if std::mem::take(&mut self.base.same_unknowns) && self.base.valid && self.base.secant == secant {
+            #[cfg(debug_assertions)]
+            debug_assert!(self.base.q == q, "the unknowns moved since the assembly being reused");
             self.f.copy_from_slice(&self.base.f);
             return self.assemble_interface(c, q, secant, self.base.ok);
         }
@@ -536,6 +541,11 @@ impl<'a> Solver<'a> {
         base.ok = ok;
         base.f.clear();
         base.f.extend_from_slice(&self.f);
+        #[cfg(debug_assertions)]
+        {
+            base.q.clear();
+            base.q.extend_from_slice(q);
+        }
         self.assemble_interface(c, q, secant, ok)
     }
 
