@@ -111,6 +111,22 @@ pub trait CohesiveLaw: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// Number of kinks in the response between damage onset and complete failure that the damage
+    /// does not mark (default 0), such as one part of a superposed law failing while another
+    /// still carries load. The interface integration places a front at each, as at onset and
+    /// complete failure, so that the forces stay exact and smooth while such a kink crosses an
+    /// element: without it, the kink moves point by point and a steep law snaps back at each.
+    fn inner_kinks(&self) -> usize {
+        0
+    }
+
+    /// Whether `state` lies beyond inner kink `k` (`k <` [`CohesiveLaw::inner_kinks`]) along its
+    /// loading path: `false` before it, `true` from it on, never back.
+    fn beyond_inner_kink(&self, state: &LawState, k: usize) -> bool {
+        let _ = (state, k);
+        false
+    }
+
     /// The law with a fibre-bridging tail added (an R-curve): a long, weak part of strength
     /// `strength` (MPa) that vanishes at opening `opening` (mm), superposed on this law; `None`
     /// when the law has no such extension (default). At `strength = 0` the law itself.

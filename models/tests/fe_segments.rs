@@ -17,15 +17,10 @@ use fe_support::TestBilinear;
 fn forces(law: &dyn CohesiveLaw, ga: Gap, gb: Gap, m: Option<&ModeOne>) -> fe::segment::SegmentForces {
     let init = LawState::default();
     let (ea, eb) = (law.evaluate(&ga, &init), law.evaluate(&gb, &init));
-    let end = |g: Gap, e: &czid_core::LawEval| End {
-        gap: g,
-        t: e.traction,
-        d: e.tangent,
-        damage: e.state.damage,
-        state: &init,
-    };
+    let a = End { gap: ga, t: ea.traction, d: ea.tangent, trial: &ea.state, state: &init };
+    let b = End { gap: gb, t: eb.traction, d: eb.tangent, trial: &eb.state, state: &init };
     let s = Segment { a: 0, b: 1, x: 0.0, len: 1.0, weight: 1.0 };
-    integrate(&s, &end(ga, &ea), &end(gb, &eb), law, m)
+    integrate(&s, &a, &b, law, m)
 }
 
 /// `∫ N T(g(η)) dη` on the monotone virgin law by Simpson's rule on pieces split at `kinks`
@@ -90,6 +85,42 @@ fn segment_forces_are_exact_for_laws_linear_along_the_path() {
     let e = exact(&bl, ga, gb, &[]);
     for i in 0..2 {
         assert!((f[i] - e[i]).norm() <= 0.05 * e[0].norm(), "{:?} vs {:?}", f[i], e[i]);
+    }
+}
+
+#[test]
+fn a_bridging_law_has_a_front_where_its_matrix_fails() {
+    // The matrix's failure inside a law with a bridging tail is a kink its damage does not mark
+    // (the tail still carries load): the segment places a front there too, so the forces stay
+    // exact for the piecewise linear law, and their Jacobian is the forces' derivative.
+    let matrix = Bilinear::bk(1e5, 30.0, 30.0, 0.8, 2.0, 2.0).unwrap();
+    let law = matrix.with_bridging_tail(0.5, 1.0).unwrap().unwrap();
+    let m = ModeOne::of(law.as_ref()).unwrap();
+    let (matrix_failure, _, _) = m.inner[0].expect("the matrix's failure");
+    assert!((matrix_failure - 2.0 * 0.8 / 30.0).abs() < 1e-12, "{matrix_failure}");
+    for (ga, gb) in [(0.08, 0.03), (0.08, 0.0001), (1.2, 0.03)] {
+        let (ga, gb) = (Gap::new(ga, 0.0), Gap::new(gb, 0.0));
+        let f = forces(law.as_ref(), ga, gb, Some(&m)).f;
+        let e = exact(law.as_ref(), ga, gb, &[m.onset, matrix_failure, m.failure.unwrap()]);
+        for i in 0..2 {
+            assert!((f[i] - e[i]).norm() <= 1e-9 * e[0].norm(), "{ga:?} {gb:?}: {:?} vs {:?}", f[i], e[i]);
+        }
+        let sf = forces(law.as_ref(), ga, gb, Some(&m));
+        let scale = sf.jac.iter().flatten().map(|j| j.norm()).fold(0.0, f64::max);
+        let h = 1e-7 * ga.norm();
+        for j in 0..2 {
+            let d = Gap::new(h, 0.0);
+            let (p, q) = if j == 0 {
+                (forces(law.as_ref(), ga + d, gb, Some(&m)), forces(law.as_ref(), ga - d, gb, Some(&m)))
+            } else {
+                (forces(law.as_ref(), ga, gb + d, Some(&m)), forces(law.as_ref(), ga, gb - d, Some(&m)))
+            };
+            for i in 0..2 {
+                let fd = (p.f[i][0] - q.f[i][0]) / (2.0 * h);
+                let an = sf.jac[i][j][(0, 0)];
+                assert!((fd - an).abs() <= 1e-6 * scale, "{ga:?} {gb:?}: ∂f{i}/∂g{j} = {an} vs {fd}");
+            }
+        }
     }
 }
 

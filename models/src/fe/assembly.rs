@@ -353,7 +353,7 @@ impl Assembler {
                 gap: self.gaps[i],
                 t: self.trial[i].traction,
                 d: self.data[i].d,
-                damage: self.trial[i].state.damage,
+                trial: &self.trial[i].state,
                 state: &states[i],
             };
             let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), law, self.mode_one.as_ref());

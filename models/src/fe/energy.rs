@@ -132,7 +132,8 @@ pub(crate) fn path_work_split(
     let at = |t: f64| g0 + dg * t;
     let traction = |t: f64| law.evaluate(&at(t), s0).traction;
     // Breakpoints: where damage starts (from a virgin state) and where it completes.
-    let mut bp = [0.0, 1.0, 1.0, 1.0];
+    let mut bp = [1.0; 4 + super::segment::MAX_INNER_KINKS];
+    bp[0] = 0.0;
     let mut n = 1;
     let pure = g0[1] == 0.0 && g1[1] == 0.0;
     let split = |level: Option<f64>, beyond: &dyn Fn(f64) -> bool| -> Option<f64> {
@@ -167,6 +168,16 @@ pub(crate) fn path_work_split(
         if let Some(t) = split(mode_one.and_then(|m| m.failure), &|t| law.evaluate(&at(t), s0).state.damage >= 1.0) {
             bp[n] = t;
             n += 1;
+        }
+    }
+    // The law's inner kinks.
+    for k in 0..law.inner_kinks().min(super::segment::MAX_INNER_KINKS) {
+        if !law.beyond_inner_kink(s0, k) && law.beyond_inner_kink(after, k) {
+            let level = mode_one.and_then(|m| m.inner[k]).map(|(g, _, _)| g);
+            if let Some(t) = split(level, &|t| law.beyond_inner_kink(&law.evaluate(&at(t), s0).state, k)) {
+                bp[n] = t;
+                n += 1;
+            }
         }
     }
     bp[n] = 1.0;

@@ -130,7 +130,13 @@ pub struct ModeOne {
     /// Traction and tangent of failed material at that opening.
     pub failure_traction: Traction,
     pub failure_tangent: Tangent,
+    /// The law's inner kinks ([`CohesiveLaw::inner_kinks`], at most [`MAX_INNER_KINKS`]): the
+    /// smallest opening beyond each, and the traction and tangent just beyond it.
+    pub inner: [Option<(f64, Traction, Tangent)>; MAX_INNER_KINKS],
 }
+
+/// Inner kinks of a law that the segments place fronts at (further ones are not resolved).
+pub const MAX_INNER_KINKS: usize = 2;
 
 impl ModeOne {
     /// Finds the fronts by bisection to round-off; `None` if the law damages from the first
@@ -166,6 +172,20 @@ impl ModeOne {
         }
         // Failed side of the front (the bisection returns the last opening below it).
         let at_failure = failure.map(|g| law.evaluate(&Gap::new(next_up(g), 0.0), &init));
+        let mut inner = [None; MAX_INNER_KINKS];
+        for (k, slot) in inner.iter_mut().enumerate().take(law.inner_kinks()) {
+            let beyond = |g: f64| law.beyond_inner_kink(&law.evaluate(&Gap::new(g, 0.0), &init).state, k);
+            let mut hi = 2.0 * onset;
+            for _ in 0..80 {
+                if beyond(hi) {
+                    let g = bisect(onset, hi, beyond);
+                    let e = law.evaluate(&Gap::new(next_up(g), 0.0), &init);
+                    *slot = Some((g, e.traction, e.tangent));
+                    break;
+                }
+                hi *= 2.0;
+            }
+        }
         Some(ModeOne {
             onset,
             onset_traction: at_onset.traction,
@@ -173,6 +193,7 @@ impl ModeOne {
             failure,
             failure_traction: at_failure.map_or(Traction::zeros(), |e| e.traction),
             failure_tangent: at_failure.map_or(Tangent::zeros(), |e| e.tangent),
+            inner,
         })
     }
 }
@@ -234,8 +255,8 @@ pub struct End<'a> {
     pub t: Traction,
     /// Iteration tangent.
     pub d: Tangent,
-    /// Trial damage.
-    pub damage: f64,
+    /// Trial state.
+    pub trial: &'a LawState,
     /// Committed state.
     pub state: &'a LawState,
 }
@@ -244,11 +265,12 @@ pub struct End<'a> {
 pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one: Option<&ModeOne>) -> SegmentForces {
     let w = s.weight;
     let mut fronts = [None, None];
-    let mut kinks: [Option<Front>; 2] = [None, None];
+    // Onset, complete failure, and the law's inner kinks.
+    let mut kinks: [Option<Front>; 2 + MAX_INNER_KINKS] = [None; 2 + MAX_INNER_KINKS];
     let pure_one = a.gap[1] == 0.0 && b.gap[1] == 0.0 && a.gap[0] > 0.0 && b.gap[0] > 0.0;
     let init = law.initial_state();
     // Onset front: one end damaged, the other never damaged.
-    let (da, db) = (a.damage > 0.0, b.damage > 0.0);
+    let (da, db) = (a.trial.damage > 0.0, b.trial.damage > 0.0);
     if da != db {
         let intact = if da { b } else { a };
         if intact.state.damage <= 0.0 {
@@ -259,7 +281,7 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
         }
     }
     // Failure front: one end failed, the other not.
-    let (fa, fb) = (a.damage >= 1.0, b.damage >= 1.0);
+    let (fa, fb) = (a.trial.damage >= 1.0, b.trial.damage >= 1.0);
     if fa != fb {
         let other = if fa { b } else { a };
         kinks[1] = match (pure_one, mode_one.and_then(|m| m.failure.map(|g| (g, m)))) {
@@ -267,7 +289,19 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
             _ => located(a, b, &|g| law.evaluate(g, other.state), |e| e.state.damage >= 1.0, !fa, false),
         };
     }
-    if kinks[0].is_none() && kinks[1].is_none() {
+    // Inner kinks: one end beyond, the other not.
+    for k in 0..law.inner_kinks().min(MAX_INNER_KINKS) {
+        let (ka, kb) = (law.beyond_inner_kink(a.trial, k), law.beyond_inner_kink(b.trial, k));
+        if ka == kb {
+            continue;
+        }
+        let other = if ka { b } else { a };
+        kinks[2 + k] = match (pure_one, mode_one.and_then(|m| m.inner[k])) {
+            (true, Some((g, t, d))) => fixed_opening(a, b, g, t, &d),
+            _ => located(a, b, &|g| law.evaluate(g, other.state), |e| law.beyond_inner_kink(&e.state, k), !ka, false),
+        };
+    }
+    if kinks.iter().all(Option::is_none) {
         let (ta, tb) = (a.t, b.t);
         return SegmentForces {
             f: [(ta * 2.0 + tb) * (w / 6.0), (ta + tb * 2.0) * (w / 6.0)],
@@ -276,15 +310,15 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
             stored: half_product(1.0, ta, tb, a.gap, b.gap) * w,
         };
     }
-    for (slot, k) in fronts.iter_mut().zip(&kinks) {
+    for (slot, k) in fronts.iter_mut().zip(&kinks[..2]) {
         *slot = k.map(|k| k.eta);
     }
     // Breakpoints along η: the ends and the fronts, in order.
     let mut inner: Vec<Front> = kinks.iter().flatten().copied().collect();
     inner.sort_by(|x, y| x.eta.total_cmp(&y.eta));
     let n = inner.len() + 2;
-    let mut xs = [0.0; 4];
-    let mut ts = [Traction::zeros(); 4];
+    let mut xs = [0.0; 4 + MAX_INNER_KINKS];
+    let mut ts = [Traction::zeros(); 4 + MAX_INNER_KINKS];
     xs[0] = 0.0;
     ts[0] = a.t;
     for (k, fr) in inner.iter().enumerate() {
@@ -296,8 +330,8 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
     // f_a = w Σ ∫ (1 − η) T dη, f_b = w Σ ∫ η T dη over pieces with linear T; and the
     // coefficients of each breakpoint's traction and position.
     let mut f = [Traction::zeros(); 2];
-    let mut ct = [[0.0; 4]; 2]; // ∂f_i/∂T_k (scalar, per component)
-    let mut cx = [[Traction::zeros(); 4]; 2]; // ∂f_i/∂x_k
+    let mut ct = [[0.0; 4 + MAX_INNER_KINKS]; 2]; // ∂f_i/∂T_k (scalar, per component)
+    let mut cx = [[Traction::zeros(); 4 + MAX_INNER_KINKS]; 2]; // ∂f_i/∂x_k
     for p in 0..n - 1 {
         let (x0, x1, t0, t1) = (xs[p], xs[p + 1], ts[p], ts[p + 1]);
         let l = x1 - x0;

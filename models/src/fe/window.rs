@@ -957,7 +957,7 @@ impl<'a, const D: usize> Solver<'a, D> {
                 gap: self.gaps[i],
                 t: self.ev[i].traction,
                 d: self.dt[i],
-                damage: self.ev[i].state.damage,
+                trial: &self.ev[i].state,
                 state: &states[i],
             };
             let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), self.law, Some(&self.mode_one));

@@ -134,6 +134,16 @@ impl CohesiveLaw for Bridging {
         LawEval { traction: t_m + t_b, tangent: k_m + k_b, state: LawState { damage, history } }
     }
 
+    /// The failure of the part that fails first (the matrix, for a bridging tail): a kink inside
+    /// the combined law; the other part's failure is the law's complete failure.
+    fn inner_kinks(&self) -> usize {
+        1
+    }
+
+    fn beyond_inner_kink(&self, state: &LawState, _k: usize) -> bool {
+        state.history[0] >= 1.0 || state.history[1] >= 1.0
+    }
+
     fn fracture_energy(&self) -> [f64; 2] {
         let (a, b) = (self.matrix.fracture_energy(), self.bridging.fracture_energy());
         [a[0] + b[0], a[1] + b[1]]
