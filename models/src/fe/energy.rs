@@ -170,8 +170,10 @@ pub(crate) fn path_work_split(
             n += 1;
         }
     }
-    // The law's inner kinks.
-    for k in 0..law.inner_kinks().min(super::segment::MAX_INNER_KINKS) {
+    // The law's inner kinks (most laws have none).
+    let inner_count =
+        mode_one.map_or_else(|| law.inner_kinks().min(super::segment::MAX_INNER_KINKS), |m| m.inner_count);
+    for k in 0..inner_count {
         if !law.beyond_inner_kink(s0, k) && law.beyond_inner_kink(after, k) {
             let level = mode_one.and_then(|m| m.inner[k]).map(|(g, _, _)| g);
             if let Some(t) = split(level, &|t| law.beyond_inner_kink(&law.evaluate(&at(t), s0).state, k)) {

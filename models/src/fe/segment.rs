@@ -133,6 +133,8 @@ pub struct ModeOne {
     /// The law's inner kinks ([`CohesiveLaw::inner_kinks`], at most [`MAX_INNER_KINKS`]): the
     /// smallest opening beyond each, and the traction and tangent just beyond it.
     pub inner: [Option<(f64, Traction, Tangent)>; MAX_INNER_KINKS],
+    /// How many inner kinks the law has (kept here so that integration asks the law once a run).
+    pub inner_count: usize,
 }
 
 /// Inner kinks of a law that the segments place fronts at (further ones are not resolved).
@@ -172,8 +174,9 @@ impl ModeOne {
         }
         // Failed side of the front (the bisection returns the last opening below it).
         let at_failure = failure.map(|g| law.evaluate(&Gap::new(next_up(g), 0.0), &init));
+        let inner_count = law.inner_kinks().min(MAX_INNER_KINKS);
         let mut inner = [None; MAX_INNER_KINKS];
-        for (k, slot) in inner.iter_mut().enumerate().take(law.inner_kinks()) {
+        for (k, slot) in inner.iter_mut().enumerate().take(inner_count) {
             let beyond = |g: f64| law.beyond_inner_kink(&law.evaluate(&Gap::new(g, 0.0), &init).state, k);
             let mut hi = 2.0 * onset;
             for _ in 0..80 {
@@ -194,6 +197,7 @@ impl ModeOne {
             failure_traction: at_failure.map_or(Traction::zeros(), |e| e.traction),
             failure_tangent: at_failure.map_or(Tangent::zeros(), |e| e.tangent),
             inner,
+            inner_count,
         })
     }
 }
@@ -265,8 +269,7 @@ pub struct End<'a> {
 pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one: Option<&ModeOne>) -> SegmentForces {
     let w = s.weight;
     let mut fronts = [None, None];
-    // Onset, complete failure, and the law's inner kinks.
-    let mut kinks: [Option<Front>; 2 + MAX_INNER_KINKS] = [None; 2 + MAX_INNER_KINKS];
+    let mut kinks: [Option<Front>; 2] = [None, None];
     let pure_one = a.gap[1] == 0.0 && b.gap[1] == 0.0 && a.gap[0] > 0.0 && b.gap[0] > 0.0;
     let init = law.initial_state();
     // Onset front: one end damaged, the other never damaged.
@@ -289,19 +292,10 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
             _ => located(a, b, &|g| law.evaluate(g, other.state), |e| e.state.damage >= 1.0, !fa, false),
         };
     }
-    // Inner kinks: one end beyond, the other not.
-    for k in 0..law.inner_kinks().min(MAX_INNER_KINKS) {
-        let (ka, kb) = (law.beyond_inner_kink(a.trial, k), law.beyond_inner_kink(b.trial, k));
-        if ka == kb {
-            continue;
-        }
-        let other = if ka { b } else { a };
-        kinks[2 + k] = match (pure_one, mode_one.and_then(|m| m.inner[k])) {
-            (true, Some((g, t, d))) => fixed_opening(a, b, g, t, &d),
-            _ => located(a, b, &|g| law.evaluate(g, other.state), |e| law.beyond_inner_kink(&e.state, k), !ka, false),
-        };
-    }
-    if kinks.iter().all(Option::is_none) {
+    // The law's inner kinks, where it has any (most laws have none: no work for them here).
+    let inner_kinks = mode_one.map_or_else(|| law.inner_kinks(), |m| m.inner_count);
+    let inner_fronts = if inner_kinks > 0 { inner_fronts(a, b, law, mode_one, pure_one, inner_kinks) } else { None };
+    if kinks[0].is_none() && kinks[1].is_none() && inner_fronts.is_none() {
         let (ta, tb) = (a.t, b.t);
         return SegmentForces {
             f: [(ta * 2.0 + tb) * (w / 6.0), (ta + tb * 2.0) * (w / 6.0)],
@@ -310,11 +304,14 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
             stored: half_product(1.0, ta, tb, a.gap, b.gap) * w,
         };
     }
-    for (slot, k) in fronts.iter_mut().zip(&kinks[..2]) {
+    for (slot, k) in fronts.iter_mut().zip(&kinks) {
         *slot = k.map(|k| k.eta);
     }
     // Breakpoints along η: the ends and the fronts, in order.
     let mut inner: Vec<Front> = kinks.iter().flatten().copied().collect();
+    if let Some(more) = inner_fronts {
+        inner.extend(more.iter().flatten().copied());
+    }
     inner.sort_by(|x, y| x.eta.total_cmp(&y.eta));
     let n = inner.len() + 2;
     let mut xs = [0.0; 4 + MAX_INNER_KINKS];
@@ -373,6 +370,31 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
         fronts,
         stored: stored * w,
     }
+}
+
+/// Fronts at the law's first `count` inner kinks (at most [`MAX_INNER_KINKS`]) where one end is
+/// beyond the kink and the other not; `None` if there is none.
+fn inner_fronts(
+    a: &End,
+    b: &End,
+    law: &dyn CohesiveLaw,
+    mode_one: Option<&ModeOne>,
+    pure_one: bool,
+    count: usize,
+) -> Option<[Option<Front>; MAX_INNER_KINKS]> {
+    let mut fronts = [None; MAX_INNER_KINKS];
+    for (k, slot) in fronts.iter_mut().enumerate().take(count) {
+        let (ka, kb) = (law.beyond_inner_kink(a.trial, k), law.beyond_inner_kink(b.trial, k));
+        if ka == kb {
+            continue;
+        }
+        let other = if ka { b } else { a };
+        *slot = match (pure_one, mode_one.and_then(|m| m.inner[k])) {
+            (true, Some((g, t, d))) => fixed_opening(a, b, g, t, &d),
+            _ => located(a, b, &|g| law.evaluate(g, other.state), |e| law.beyond_inner_kink(&e.state, k), !ka, false),
+        };
+    }
+    fronts.iter().any(Option::is_some).then_some(fronts)
 }
 
 /// `∫ ½ T·g` over a piece of length `l` (fraction of the segment) on which `T` and `g` are linear.
