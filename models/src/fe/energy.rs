@@ -136,51 +136,26 @@ pub(crate) fn path_work_split(
     bp[0] = 0.0;
     let mut n = 1;
     let pure = g0[1] == 0.0 && g1[1] == 0.0;
-    let split = |level: Option<f64>, beyond: &dyn Fn(f64) -> bool| -> Option<f64> {
-        if let (true, Some(g)) = (pure, level) {
-            let (a, b) = (g0[0], g1[0]);
-            if (a - g) * (b - g) < 0.0 {
-                return Some((g - a) / (b - a));
-            }
-            return None;
-        }
-        if beyond(0.0) || !beyond(1.0) {
-            return None;
-        }
-        let (mut lo, mut hi) = (0.0f64, 1.0f64);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if beyond(mid) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Some(lo)
-    };
+    let openings = (g0[0], g1[0]);
     if s0.damage <= 0.0 && after.damage > 0.0 {
-        if let Some(t) = split(mode_one.map(|m| m.onset), &|t| law.evaluate(&at(t), s0).state.damage > 0.0) {
+        let onset = mode_one.map(|m| m.onset);
+        if let Some(t) = split(pure, openings, onset, &|t| law.evaluate(&at(t), s0).state.damage > 0.0) {
             bp[n] = t;
             n += 1;
         }
     }
     if s0.damage < 1.0 && after.damage >= 1.0 {
-        if let Some(t) = split(mode_one.and_then(|m| m.failure), &|t| law.evaluate(&at(t), s0).state.damage >= 1.0) {
+        let failure = mode_one.and_then(|m| m.failure);
+        if let Some(t) = split(pure, openings, failure, &|t| law.evaluate(&at(t), s0).state.damage >= 1.0) {
             bp[n] = t;
             n += 1;
         }
     }
-    // The law's inner kinks (most laws have none).
+    // The law's inner kinks (most laws have none: they pay for this test only).
     let inner_count =
         mode_one.map_or_else(|| law.inner_kinks().min(super::segment::MAX_INNER_KINKS), |m| m.inner_count);
-    for k in 0..inner_count {
-        if !law.beyond_inner_kink(s0, k) && law.beyond_inner_kink(after, k) {
-            let level = mode_one.and_then(|m| m.inner[k]).map(|(g, _, _)| g);
-            if let Some(t) = split(level, &|t| law.beyond_inner_kink(&law.evaluate(&at(t), s0).state, k)) {
-                bp[n] = t;
-                n += 1;
-            }
-        }
+    if inner_count > 0 {
+        n = inner_kink_breakpoints(law, s0, after, (g0, g1), mode_one, inner_count, &mut bp, n);
     }
     bp[n] = 1.0;
     bp[1..n].sort_by(f64::total_cmp);
@@ -205,6 +180,61 @@ pub(crate) fn path_work_split(
         ws += (b - a) / 6.0 * simpson[1] * dg[1];
     }
     (w, ws)
+}
+
+/// Where along a step (a fraction of it) a point crosses a level of its path: at the law's
+/// opening `level` when the path is pure opening (exact), else by bisection on `beyond`; `None`
+/// if the step does not cross it.
+fn split(pure: bool, (a, b): (f64, f64), level: Option<f64>, beyond: &dyn Fn(f64) -> bool) -> Option<f64> {
+    if let (true, Some(g)) = (pure, level) {
+        if (a - g) * (b - g) < 0.0 {
+            return Some((g - a) / (b - a));
+        }
+        return None;
+    }
+    if beyond(0.0) || !beyond(1.0) {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if beyond(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(lo)
+}
+
+/// Adds to the breakpoints `bp[..n]` of [`path_work_split`] the law's first `count` inner kinks
+/// that the step crosses; returns the new count. Kept out of line: most laws have no inner kink.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn inner_kink_breakpoints(
+    law: &dyn CohesiveLaw,
+    s0: &LawState,
+    after: &LawState,
+    (g0, g1): (Gap, Gap),
+    mode_one: Option<&ModeOne>,
+    count: usize,
+    bp: &mut [f64],
+    mut n: usize,
+) -> usize {
+    let dg = g1 - g0;
+    let pure = g0[1] == 0.0 && g1[1] == 0.0;
+    let openings = (g0[0], g1[0]);
+    for k in 0..count {
+        if !law.beyond_inner_kink(s0, k) && law.beyond_inner_kink(after, k) {
+            let level = mode_one.and_then(|m| m.inner[k]).map(|(g, _, _)| g);
+            let beyond = |t: f64| law.beyond_inner_kink(&law.evaluate(&(g0 + dg * t), s0).state, k);
+            if let Some(t) = split(pure, openings, level, &beyond) {
+                bp[n] = t;
+                n += 1;
+            }
+        }
+    }
+    n
 }
 
 /// Recoverable energy of the interface points (N·mm) in the states of the evaluations `trial` at `gaps`.

@@ -271,7 +271,6 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
     let mut fronts = [None, None];
     let mut kinks: [Option<Front>; 2] = [None, None];
     let pure_one = a.gap[1] == 0.0 && b.gap[1] == 0.0 && a.gap[0] > 0.0 && b.gap[0] > 0.0;
-    let init = law.initial_state();
     // Onset front: one end damaged, the other never damaged.
     let (da, db) = (a.trial.damage > 0.0, b.trial.damage > 0.0);
     if da != db {
@@ -279,7 +278,10 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
         if intact.state.damage <= 0.0 {
             kinks[0] = match (pure_one, mode_one) {
                 (true, Some(m)) => fixed_opening(a, b, m.onset, m.onset_traction, &m.onset_tangent),
-                _ => located(a, b, &|g| law.evaluate(g, &init), |e| e.state.damage > 0.0, !da, true),
+                _ => {
+                    let init = law.initial_state();
+                    located(a, b, &|g| law.evaluate(g, &init), |e| e.state.damage > 0.0, !da, true)
+                }
             };
         }
     }
@@ -294,31 +296,37 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
     }
     // The law's inner kinks, where it has any (most laws have none: no work for them here).
     let inner_kinks = mode_one.map_or_else(|| law.inner_kinks(), |m| m.inner_count);
+    let smooth = kinks[0].is_none() && kinks[1].is_none();
+    if smooth && inner_kinks == 0 {
+        return linear_segment(a, b, w);
+    }
     let inner_fronts = if inner_kinks > 0 { inner_fronts(a, b, law, mode_one, pure_one, inner_kinks) } else { None };
-    if kinks[0].is_none() && kinks[1].is_none() && inner_fronts.is_none() {
-        let (ta, tb) = (a.t, b.t);
-        return SegmentForces {
-            f: [(ta * 2.0 + tb) * (w / 6.0), (ta + tb * 2.0) * (w / 6.0)],
-            jac: [[a.d * (w / 3.0), b.d * (w / 6.0)], [a.d * (w / 6.0), b.d * (w / 3.0)]],
-            fronts,
-            stored: half_product(1.0, ta, tb, a.gap, b.gap) * w,
-        };
+    if smooth && inner_fronts.is_none() {
+        return linear_segment(a, b, w);
     }
     for (slot, k) in fronts.iter_mut().zip(&kinks) {
         *slot = k.map(|k| k.eta);
     }
-    // Breakpoints along η: the ends and the fronts, in order.
-    let mut inner: Vec<Front> = kinks.iter().flatten().copied().collect();
-    if let Some(more) = inner_fronts {
-        inner.extend(more.iter().flatten().copied());
+    // Breakpoints along η: the ends and the fronts, in order (at most four fronts, so they are
+    // kept on the stack and sorted by insertion).
+    let mut found = [None; 2 + MAX_INNER_KINKS];
+    let mut count = 0;
+    for fr in kinks.iter().chain(inner_fronts.iter().flatten()).flatten() {
+        let mut k = count;
+        while k > 0 && found[k - 1].is_some_and(|p: Front| p.eta > fr.eta) {
+            found[k] = found[k - 1];
+            k -= 1;
+        }
+        found[k] = Some(*fr);
+        count += 1;
     }
-    inner.sort_by(|x, y| x.eta.total_cmp(&y.eta));
-    let n = inner.len() + 2;
+    let inner = &found[..count];
+    let n = count + 2;
     let mut xs = [0.0; 4 + MAX_INNER_KINKS];
     let mut ts = [Traction::zeros(); 4 + MAX_INNER_KINKS];
     xs[0] = 0.0;
     ts[0] = a.t;
-    for (k, fr) in inner.iter().enumerate() {
+    for (k, fr) in inner.iter().flatten().enumerate() {
         xs[k + 1] = fr.eta;
         ts[k + 1] = fr.t;
     }
@@ -352,7 +360,7 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
     for i in 0..2 {
         jac[i][0] = a.d * ct[i][0];
         jac[i][1] = b.d * ct[i][n - 1];
-        for (k, fr) in inner.iter().enumerate() {
+        for (k, fr) in inner.iter().flatten().enumerate() {
             for j in 0..2 {
                 jac[i][j] += fr.dt[j] * ct[i][k + 1];
                 let c = cx[i][k + 1];
@@ -369,6 +377,18 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
         jac: [[jac[0][0] * w, jac[0][1] * w], [jac[1][0] * w, jac[1][1] * w]],
         fronts,
         stored: stored * w,
+    }
+}
+
+/// Forces of a segment with no front inside: the traction is linear along it.
+#[inline]
+fn linear_segment(a: &End, b: &End, w: f64) -> SegmentForces {
+    let (ta, tb) = (a.t, b.t);
+    SegmentForces {
+        f: [(ta * 2.0 + tb) * (w / 6.0), (ta + tb * 2.0) * (w / 6.0)],
+        jac: [[a.d * (w / 3.0), b.d * (w / 6.0)], [a.d * (w / 6.0), b.d * (w / 3.0)]],
+        fronts: [None, None],
+        stored: half_product(1.0, ta, tb, a.gap, b.gap) * w,
     }
 }
 
