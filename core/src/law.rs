@@ -102,12 +102,12 @@ pub trait CohesiveLaw: Send + Sync + std::fmt::Debug {
         0.5 * self.evaluate(gap, state).traction.dot(gap)
     }
 
-    /// Damage at which the crack that an observer sees lies, when that is not complete failure
-    /// (default `None`: the visible crack is where the law has failed completely). A law whose
-    /// damage reaches 1 only long after the visible crack has passed (fibres still bridging
-    /// behind a matrix crack) returns the damage of its visible front, and a forward model that
-    /// records a crack length places the front there.
-    fn visible_front_damage(&self) -> Option<f64> {
+    /// The inner kink ([`CohesiveLaw::inner_kinks`]) at which the crack that an observer sees
+    /// lies, when that is not complete failure (default `None`: the visible crack is where the law
+    /// has failed completely). A law whose damage reaches 1 only long after the visible crack has
+    /// passed (fibres still bridging behind a matrix crack) names the kink where its matrix fails,
+    /// and a forward model that records a crack length places the front there.
+    fn visible_front_kink(&self) -> Option<usize> {
         None
     }
 

@@ -403,6 +403,7 @@ impl ControlSettings {
             outputs: self.output_points,
             min_step_fraction: 1e-3,
             damage_threshold: self.damage_threshold,
+            visible_kink: None,
             crack_origin,
             newton: crate::fe::NewtonSettings { max_iterations: self.max_iterations, tolerance: self.tolerance },
         }

@@ -310,16 +310,10 @@ impl Dcb {
     }
 
     fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
-        let mut path = self.control.path(self.max_opening(law) / scale.displacement, self.effective_crack_length());
-        // The debonded length is the visible crack (what a camera sees): with the default threshold
-        // (complete failure) it follows the law's visible front when that lies earlier, e.g. the
-        // matrix crack ahead of bridging fibres; a threshold chosen by the user stays.
-        if path.damage_threshold >= 1.0 - 1.0001e-6 {
-            if let Some(level) = law.visible_front_damage() {
-                path.damage_threshold = level;
-            }
-        }
-        path
+        // The debonded length is the visible crack (what a camera sees).
+        self.control
+            .path(self.max_opening(law) / scale.displacement, self.effective_crack_length())
+            .with_visible_front(law)
     }
 }
 

@@ -1,16 +1,18 @@
-//! A DCB whose law carries a fibre-bridging tail (the diagnosis's bridging candidate). As the
-//! tail's strength goes to zero the record approaches the matrix law's own, continuously, on a
-//! steep matrix law too. The matrix's failure is a kink of the combined law that its damage does
+//! A DCB (and an ENF) whose law carries a fibre-bridging tail (the diagnosis's bridging
+//! candidate). As the tail's strength goes to zero the record approaches the matrix law's own,
+//! continuously, on a steep matrix law too, the debonded length included (the matrix crack, the
+//! law's visible front). The matrix's failure is a kink of the combined law that its damage does
 //! not mark; without a segment front there the kink moved point by point, and these runs either
 //! failed or jumped away from the matrix law's record (`CohesiveLaw::inner_kinks`).
 use czid_core::{CohesiveLaw, ForwardModel};
 use czid_models::dcb::Dcb;
 use czid_models::laws::Bilinear;
 
-/// Load (N) at the last reading of a run to 12 mm.
-fn last_load(d: &Dcb, law: &dyn CohesiveLaw) -> f64 {
+/// Load (N) and debonded length (mm) at the last reading of a run to 12 mm.
+fn last_reading(d: &Dcb, law: &dyn CohesiveLaw) -> (f64, f64) {
     let r = d.simulate(law).unwrap();
-    *r.column("load").unwrap().last().unwrap()
+    let last = |name: &str| *r.column(name).unwrap().last().unwrap();
+    (last("load"), last("debonded_length"))
 }
 
 #[test]
@@ -23,13 +25,46 @@ fn a_vanishing_bridging_tail_approaches_the_matrix_law_continuously() {
         d.control.max_displacement = Some(12.0);
         let matrix = Bilinear::bk(1e5, strength, 30.0, g_ic, 2.0, 2.0).unwrap();
         let tail = |s: f64| matrix.with_bridging_tail(s, 1.609).unwrap().unwrap();
-        let p0 = last_load(&d, &matrix);
-        let (p_small, p_large) = (last_load(&d, tail(1e-6).as_ref()), last_load(&d, tail(1e-4).as_ref()));
+        let (p0, a0) = last_reading(&d, &matrix);
+        let (p_small, a_small) = last_reading(&d, tail(1e-6).as_ref());
+        let (p_large, a_large) = last_reading(&d, tail(1e-4).as_ref());
         // Linear in the tail's strength near zero: at 10⁻⁶ MPa a hundredth of the change at 10⁻⁴.
         let ratio = (p_small - p0) / (p_large - p0);
         assert!(
             p_large > p0 && (ratio - 0.01).abs() < 0.003,
             "E11 {e11}: P {p0} N without the tail, {p_small} and {p_large} N with 1e-6 and 1e-4 MPa (ratio {ratio})"
         );
+        // The debonded length is the matrix crack's (the law's visible front), with or without
+        // the tail: it too changes linearly, the bridging tractions holding the crack back.
+        let ratio = (a_small - a0) / (a_large - a0);
+        assert!(
+            a_large < a0 && (ratio - 0.01).abs() < 0.003,
+            "E11 {e11}: a {a0} mm without the tail, {a_small} and {a_large} mm with 1e-6 and 1e-4 MPa (ratio {ratio})"
+        );
     }
+}
+
+#[test]
+fn an_enf_measures_the_matrix_crack_of_a_bridging_law_too() {
+    // Hartlen's ENF-03 with a mode II toughness that lets the crack grow stably to the nose.
+    let e = czid_models::enf::Enf::hartlen_enf03();
+
+    let matrix = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
+    let tail = |s: f64| matrix.with_bridging_tail(s, 1.609).unwrap().unwrap();
+    let reading = |law: &dyn CohesiveLaw| {
+        let r = e.simulate(law).unwrap();
+        let last = |name: &str| *r.column(name).unwrap().last().unwrap();
+        (last("load"), last("debonded_length"))
+    };
+    let (p0, a0) = reading(&matrix);
+    let (p_small, a_small) = reading(tail(1e-6).as_ref());
+    let (p_large, a_large) = reading(tail(1e-4).as_ref());
+    // The tail has failed nowhere, yet the crack the record measures is the matrix's: with a
+    // vanishing tail it is the matrix law's crack, and both readings move linearly in the tail.
+    let (ratio_p, ratio_a) = ((p_small - p0) / (p_large - p0), (a_small - a0) / (a_large - a0));
+    assert!(a0 > 20.0, "ENF: the matrix law's crack grew by {a0} mm only");
+    assert!(
+        (ratio_p - 0.01).abs() < 0.003 && (ratio_a - 0.01).abs() < 0.003,
+        "ENF: P {p0}, {p_small}, {p_large} N; a {a0}, {a_small}, {a_large} mm (ratios {ratio_p}, {ratio_a})"
+    );
 }

@@ -197,6 +197,7 @@ fn paper_path(target: f64, outputs: usize) -> PathSettings {
         outputs,
         min_step_fraction: 1e-3,
         damage_threshold: 1.0 - 1e-9,
+        visible_kink: None,
         crack_origin: 0.0,
         newton: NewtonSettings::default(),
     }

@@ -475,6 +475,7 @@ fn elastic_concrete_equals_a_two_layer_model_with_a_concrete_layer() {
         outputs: 35,
         min_step_fraction: 1e-3,
         damage_threshold: 1.0 - 1e-9,
+        visible_kink: None,
         crack_origin: 0.0,
         newton: NewtonSettings::default(),
     };

@@ -11,6 +11,8 @@
 //! two damaged points behind it is extrapolated to zero. Fronts are clamped to the segment
 //! between the last point inside and the first point outside.
 
+use czid_core::{CohesiveLaw, Gap, LawState};
+
 /// Lengths measured along one interface.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CrackMeasures {
@@ -152,29 +154,51 @@ pub fn measure_located(
 /// it lies within 10⁻⁹ of the opening where the damage reaches `1 − 10⁻⁹`).
 pub const FAILURE_LEVEL: f64 = 1.0 - 1e-6;
 
+/// What a crack measure counts as debonded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Debonded {
+    /// Damage at or above the level; levels from [`FAILURE_LEVEL`] on mean complete failure.
+    Damage(f64),
+    /// Material beyond the law's inner kink ([`CohesiveLaw::beyond_inner_kink`]), e.g. a matrix
+    /// that has failed while fibres still bridge ([`CohesiveLaw::visible_front_kink`]).
+    Kink(usize),
+}
+
+/// The damage level of the law's visible front ([`CohesiveLaw::visible_front_kink`]) for crack
+/// measures that place fronts by damage alone: the damage just beyond the kink in opening, kept
+/// below [`FAILURE_LEVEL`] (a level from there on means complete failure); `None` if the visible
+/// crack is complete failure.
+pub fn visible_front_level(law: &dyn CohesiveLaw) -> Option<f64> {
+    let k = law.visible_front_kink()?;
+    super::segment::inner_kink_damage(law, k).map(|d| d.min(1.0 - 1.0001e-6))
+}
+
 /// Crack measures from the interface segments ([`super::segment`]) and the fronts the last
-/// assembly found in them, `damage(i)` the damage of point `i`.
+/// assembly found in them, `point(i)` the gap and committed state of point `i`.
 ///
 /// A segment counts as debonded (damaged) from its debonded (damaged) end up to the debonded
-/// (onset) front inside it, so the measures move continuously with the fronts. Debonded means
-/// damage at or above `threshold`; for thresholds from [`FAILURE_LEVEL`] on, that is complete
-/// failure and the front is the segment rule's failure front; below, `level_front(k)` places it
-/// in segment `k` (see [`super::segment::level_front`]). Without a front between a debonded and an
-/// intact end (one that could not be placed, e.g. after unloading) half the segment counts.
-pub fn from_segments(
+/// (onset) front inside it, so the measures move continuously with the fronts. For
+/// [`Debonded::Damage`] levels from [`FAILURE_LEVEL`] on, the front is the segment rule's failure
+/// front; below, [`super::segment::level_front`] places it; for [`Debonded::Kink`],
+/// [`super::segment::kink_front`]. Without a front between a debonded and an intact end (one
+/// that could not be placed, e.g. after unloading) half the segment counts.
+pub fn from_segments<'s>(
     segments: &[super::segment::Segment],
     fronts: &[[Option<f64>; 2]],
-    damage: impl Fn(usize) -> f64,
+    law: &dyn CohesiveLaw,
+    point: impl Fn(usize) -> (Gap, &'s LawState),
     origin: f64,
-    threshold: f64,
-    level_front: impl Fn(usize) -> Option<f64>,
+    debonded_by: Debonded,
 ) -> CrackMeasures {
     let mut m = CrackMeasures { tip: origin, ..Default::default() };
     let mut damaged = 0.0;
-    let failure = threshold >= FAILURE_LEVEL;
-    let level = if failure { 1.0 } else { threshold };
-    for (k, (s, fr)) in segments.iter().zip(fronts).enumerate() {
-        let (da, db) = (damage(s.a), damage(s.b));
+    let is_debonded = |st: &LawState| match debonded_by {
+        Debonded::Damage(t) if t >= FAILURE_LEVEL => st.damage >= 1.0,
+        Debonded::Damage(t) => st.damage >= t,
+        Debonded::Kink(k) => law.beyond_inner_kink(st, k),
+    };
+    for (s, fr) in segments.iter().zip(fronts) {
+        let ((ga, sa), (gb, sb)) = (point(s.a), point(s.b));
         let part = |ea: bool, eb: bool, front: &dyn Fn() -> Option<f64>| -> (f64, f64) {
             // Fraction of the segment on the side of the ends where the property holds, and the
             // right end of that part (fraction).
@@ -188,9 +212,13 @@ pub fn from_segments(
                 (false, true) => (1.0 - front().unwrap_or(0.5), 1.0),
             }
         };
-        let debond_front = || if failure { fr[1] } else { level_front(k) };
-        let (debonded, right) = part(da >= level, db >= level, &debond_front);
-        let (dmg, _) = part(da > 0.0, db > 0.0, &|| fr[0]);
+        let debond_front = || match debonded_by {
+            Debonded::Damage(t) if t >= FAILURE_LEVEL => fr[1],
+            Debonded::Damage(t) => super::segment::level_front(law, ga, gb, sa, sb, t),
+            Debonded::Kink(k) => super::segment::kink_front(law, ga, gb, sa, sb, k),
+        };
+        let (debonded, right) = part(is_debonded(sa), is_debonded(sb), &debond_front);
+        let (dmg, _) = part(sa.damage > 0.0, sb.damage > 0.0, &|| fr[0]);
         m.debonded += debonded * s.len;
         damaged += dmg * s.len;
         if debonded > 0.0 {

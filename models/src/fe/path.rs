@@ -270,7 +270,6 @@ struct Measures {
     cohesive: Vec<usize>,
     xs: Vec<f64>,
     dmg: Vec<f64>,
-    all_damage: Vec<f64>,
     point_stored: Vec<f64>,
     scratch: Vec<f64>,
 }
@@ -299,7 +298,6 @@ impl<'a> WholeMesh<'a> {
         let xs: Vec<f64> = cohesive.iter().map(|&i| p.mesh.x[p.points[i].node]).collect();
         let measures = Measures {
             dmg: vec![0.0; cohesive.len()],
-            all_damage: vec![0.0; np],
             point_stored: vec![0.0; np],
             scratch: vec![0.0; cohesive.len()],
             cohesive,
@@ -646,23 +644,8 @@ impl<'a> WholeMesh<'a> {
     fn crack_measures(&mut self) -> CrackMeasures {
         let (law, s, m) = (self.law, self.s, &mut self.measures);
         if self.segments {
-            for (d, st) in m.all_damage.iter_mut().zip(&self.cur.states) {
-                *d = st.damage;
-            }
             let (segs, gaps, st) = (&self.nw.asm.segments, &self.nw.asm.gaps, &self.cur.states);
-            let level = |k: usize| {
-                let sg = &segs[k];
-                super::segment::level_front(law, gaps[sg.a], gaps[sg.b], &st[sg.a], &st[sg.b], s.damage_threshold)
-            };
-            let all_damage = &m.all_damage;
-            crack::from_segments(
-                segs,
-                &self.nw.asm.fronts,
-                |i| all_damage[i],
-                s.crack_origin,
-                s.damage_threshold,
-                level,
-            )
+            crack::from_segments(segs, &self.nw.asm.fronts, law, |i| (gaps[i], &st[i]), s.crack_origin, s.debonded())
         } else {
             for (d, &i) in m.dmg.iter_mut().zip(&m.cohesive) {
                 *d = self.cur.states[i].damage;

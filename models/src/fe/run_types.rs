@@ -24,10 +24,38 @@ pub struct PathSettings {
     pub min_step_fraction: f64,
     /// Damage at or above which a point counts as fully debonded.
     pub damage_threshold: f64,
+    /// The law's inner kink that marks the visible crack ([`czid_core::CohesiveLaw::visible_front_kink`]),
+    /// for crack measures that can place a front there (the segment rule); the others use
+    /// `damage_threshold`, the damage just beyond that kink ([`super::crack::visible_front_level`]).
+    pub visible_kink: Option<usize>,
     /// Position of the initial crack front (reported as the tip until something debonds).
     pub crack_origin: f64,
     /// Newton settings.
     pub newton: NewtonSettings,
+}
+
+impl PathSettings {
+    /// These settings with the debonded length at the law's visible front
+    /// ([`czid_core::CohesiveLaw::visible_front_kink`], e.g. the matrix crack ahead of bridging
+    /// fibres: what a camera sees) when that lies before complete failure. A threshold below
+    /// complete failure that the user chose stays.
+    pub fn with_visible_front(mut self, law: &dyn czid_core::CohesiveLaw) -> Self {
+        if self.damage_threshold >= 1.0 - 1.0001e-6 {
+            if let Some(level) = super::crack::visible_front_level(law) {
+                self.damage_threshold = level;
+                self.visible_kink = law.visible_front_kink();
+            }
+        }
+        self
+    }
+
+    /// What the segment rule's crack measure counts as debonded.
+    pub fn debonded(&self) -> super::crack::Debonded {
+        match self.visible_kink {
+            Some(k) => super::crack::Debonded::Kink(k),
+            None => super::crack::Debonded::Damage(self.damage_threshold),
+        }
+    }
 }
 
 /// One converged state, in the units of the simulated part (not yet scaled by symmetry).

@@ -510,19 +510,44 @@ fn located(
 /// below: bisection on the law evaluated from the less damaged end's state (the material between
 /// loaded monotonically, as for the failure front).
 pub fn level_front(law: &dyn CohesiveLaw, ga: Gap, gb: Gap, sa: &LawState, sb: &LawState, level: f64) -> Option<f64> {
-    let (da, db) = (law.evaluate(&ga, sa).state.damage, law.evaluate(&gb, sb).state.damage);
-    if (da >= level) == (db >= level) {
+    front_where(law, ga, gb, sa, sb, |st| st.damage >= level)
+}
+
+/// As [`level_front`], where the law passes its inner kink `k` ([`CohesiveLaw::beyond_inner_kink`]).
+pub fn kink_front(law: &dyn CohesiveLaw, ga: Gap, gb: Gap, sa: &LawState, sb: &LawState, k: usize) -> Option<f64> {
+    front_where(law, ga, gb, sa, sb, |st| law.beyond_inner_kink(st, k))
+}
+
+/// Where along the segment the state reached from the end that is not `beyond` becomes so.
+fn front_where(
+    law: &dyn CohesiveLaw,
+    ga: Gap,
+    gb: Gap,
+    sa: &LawState,
+    sb: &LawState,
+    beyond_at: impl Fn(&LawState) -> bool,
+) -> Option<f64> {
+    let (ba, bb) = (beyond_at(&law.evaluate(&ga, sa).state), beyond_at(&law.evaluate(&gb, sb).state));
+    if ba == bb {
         return None;
     }
-    let (from, state) = if da < level { (0.0, sa) } else { (1.0, sb) };
+    let (from, state) = if !ba { (0.0, sa) } else { (1.0, sb) };
     let gap = |eta: f64| ga * (1.0 - eta) + gb * eta;
     let beyond = |s: f64| {
         let eta = if from == 0.0 { s } else { 1.0 - s };
-        law.evaluate(&gap(eta), state).state.damage >= level
+        beyond_at(&law.evaluate(&gap(eta), state).state)
     };
     if !beyond(1.0) {
         return None;
     }
     let s = bisect(0.0, 1.0, beyond);
     Some(if from == 0.0 { s } else { 1.0 - s })
+}
+
+/// Damage just beyond the law's inner kink `k` in pure opening: the level at which models that
+/// measure a crack by damage alone place a front at that kink (`None` if the law has no such
+/// kink in opening).
+pub fn inner_kink_damage(law: &dyn CohesiveLaw, k: usize) -> Option<f64> {
+    let (g, _, _) = ModeOne::of(law)?.inner.get(k).copied().flatten()?;
+    Some(law.evaluate(&Gap::new(next_up(g), 0.0), &law.initial_state()).state.damage)
 }

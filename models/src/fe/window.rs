@@ -1208,15 +1208,9 @@ impl<'a, const D: usize> Solver<'a, D> {
         let lay = &self.lay;
         let (i0, i1) = (self.i0, self.i1);
         let (k0, k1) = (i0 - lay.first, i1 - lay.first);
-        let damage = |i: usize| self.pts[i].state.damage;
-        let level = |k: usize| {
-            let sg = &lay.segs[k0 + k];
-            let (a, b) = (&self.pts[sg.a], &self.pts[sg.b]);
-            segment::level_front(self.law, a.g, b.g, &a.state, &b.state, self.s.damage_threshold)
-        };
+        let point = |i: usize| (self.pts[i].g, &self.pts[i].state);
         let (segs, fronts) = (&lay.segs[k0..k1], &self.fronts[k0..k1]);
-        let mut m =
-            super::crack::from_segments(segs, fronts, damage, self.s.crack_origin, self.s.damage_threshold, level);
+        let mut m = super::crack::from_segments(segs, fronts, self.law, point, self.s.crack_origin, self.s.debonded());
         // The left region has failed all along.
         let failed_left = self.p.mesh.x[i0] - self.p.mesh.x[lay.first];
         if failed_left > 0.0 {
@@ -1617,6 +1611,7 @@ mod tests {
             outputs: 30,
             min_step_fraction: 1e-3,
             damage_threshold: 1.0 - 1e-9,
+            visible_kink: None,
             crack_origin: d.a0,
             newton: NewtonSettings::default(),
         };

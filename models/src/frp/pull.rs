@@ -476,6 +476,7 @@ impl FrpPull {
             outputs: self.control.output_points,
             min_step_fraction: 1e-3,
             damage_threshold: self.control.damage_threshold,
+            visible_kink: None,
             crack_origin: 0.0,
             newton: self.newton(),
         }

@@ -169,16 +169,10 @@ impl CohesiveLaw for Bridging {
         peak
     }
 
-    /// Where the matrix has failed: the combined damage there is `D* = 1 − t_b(δ_c) / ((K_m +
-    /// K_b) δ_c)`, `δ_c` the matrix's final opening and `t_b` the tail's traction (mode I; the
-    /// damage grows monotonically with the opening, so the front at `D*` is the matrix's). Levels
-    /// from `1 − 10⁻⁶` on would mean complete failure of both parts to the engine; just below it
-    /// the front lies within a hair of the matrix's failure opening.
-    fn visible_front_damage(&self) -> Option<f64> {
-        let dc = 2.0 * self.matrix.g_ic / self.matrix.strength_n;
-        let tb = pure_mode_traction(&self.bridging, 0, dc);
-        let k = self.matrix.penalty + self.bridging.penalty;
-        Some((1.0 - tb / (k * dc)).min(1.0 - 1.0001e-6))
+    /// The matrix's failure (inner kink 0) is the crack a camera sees; the fibres behind it
+    /// still bridge.
+    fn visible_front_kink(&self) -> Option<usize> {
+        Some(0)
     }
 
     fn parameters(&self) -> Vec<ParameterInfo> {
