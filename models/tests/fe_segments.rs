@@ -8,7 +8,7 @@ mod fe_support;
 use czid_core::{CohesiveLaw, Gap, LawState};
 use czid_models::dcb::Dcb;
 use czid_models::fe::segment::{integrate, End, ModeOne, Segment};
-use czid_models::fe::{self, InterfaceRule, NewtonSettings, PathSettings, RunOptions};
+use czid_models::fe::{self, InterfaceRule, PathSettings, RunOptions};
 use czid_models::laws::{Bilinear, StCzm};
 use fe_support::TestBilinear;
 
@@ -192,15 +192,7 @@ fn segment_forces_are_continuous_as_fronts_cross_points() {
 }
 
 fn paper_path(target: f64, outputs: usize) -> PathSettings {
-    PathSettings {
-        target,
-        outputs,
-        min_step_fraction: 1e-3,
-        damage_threshold: 1.0 - 1e-9,
-        visible_kink: None,
-        crack_origin: 0.0,
-        newton: NewtonSettings::default(),
-    }
+    PathSettings::new(target, outputs, 0.0)
 }
 
 #[test]

@@ -35,7 +35,7 @@
 
 use czid_core::{columns, CohesiveLaw, ForwardModel, Record};
 use czid_models::beamtest::ControlSettings;
-use czid_models::fe::{self, FeProblem, InterfacePoint, Layer, Mesh, NewtonSettings, PathSettings, PointKind, Section};
+use czid_models::fe::{self, FeProblem, InterfacePoint, Layer, Mesh, PathSettings, PointKind, Section};
 use czid_models::frp::pull::{FrpPull, PullConcrete, PullMesh, PullPlate};
 use czid_models::frp::BondedJoint;
 use czid_models::laws::{Bilinear, LuBondSlip};
@@ -470,15 +470,7 @@ fn elastic_concrete_equals_a_two_layer_model_with_a_concrete_layer() {
         contact_friction: 0.0,
     };
     let target = 0.7; // on the plateau: the loaded end separates at 0.485 mm
-    let path = PathSettings {
-        target: -target,
-        outputs: 35,
-        min_step_fraction: 1e-3,
-        damage_threshold: 1.0 - 1e-9,
-        visible_kink: None,
-        crack_origin: 0.0,
-        newton: NewtonSettings::default(),
-    };
+    let path = PathSettings::new(-target, 35, 0.0);
     let (rows, _) = fe::run(&problem, &law, &path).unwrap();
     let mut model = pull(length, h, false);
     model.control.max_displacement = Some(target);

@@ -35,6 +35,22 @@ pub struct PathSettings {
 }
 
 impl PathSettings {
+    /// A path to `target` with `outputs` equally spaced outputs, the crack starting at
+    /// `crack_origin` (mm); the rest at their usual values (steps down to 10⁻³ of the output
+    /// spacing before dissipation control, debonded meaning complete failure, default Newton
+    /// settings). Change a field to depart from them.
+    pub fn new(target: f64, outputs: usize, crack_origin: f64) -> Self {
+        PathSettings {
+            target,
+            outputs,
+            min_step_fraction: 1e-3,
+            damage_threshold: 1.0 - 1e-9,
+            visible_kink: None,
+            crack_origin,
+            newton: NewtonSettings::default(),
+        }
+    }
+
     /// These settings with the debonded length at the law's visible front
     /// ([`czid_core::CohesiveLaw::visible_front_kink`], e.g. the matrix crack ahead of bridging
     /// fibres: what a camera sees) when that lies before complete failure. A threshold below

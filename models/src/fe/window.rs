@@ -1593,7 +1593,6 @@ fn dot<const D: usize>(a: &Vct<D>, b: &Vct<D>) -> f64 {
 mod tests {
     use super::*;
     use crate::dcb::Dcb;
-    use crate::fe::newton::NewtonSettings;
     use crate::laws::StCzm;
 
     #[test]
@@ -1606,15 +1605,7 @@ mod tests {
         let mut d = Dcb::paper();
         d.control.max_displacement = Some(6.0);
         let (p, _) = d.problem().unwrap();
-        let path = PathSettings {
-            target: 3.0,
-            outputs: 30,
-            min_step_fraction: 1e-3,
-            damage_threshold: 1.0 - 1e-9,
-            visible_kink: None,
-            crack_origin: d.a0,
-            newton: NewtonSettings::default(),
-        };
+        let path = PathSettings::new(3.0, 30, d.a0);
         let (default, s_default) = run_condensing(&p, &law, &path, CONDENSE_OPENING).unwrap();
         let (eager, s_eager) = run_condensing(&p, &law, &path, 0.1).unwrap();
         let (never, s_never) = run_condensing(&p, &law, &path, f64::INFINITY).unwrap();
