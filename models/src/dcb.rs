@@ -313,7 +313,7 @@ impl Dcb {
         // The debonded length is the visible crack (what a camera sees).
         self.control
             .path(self.max_opening(law) / scale.displacement, self.effective_crack_length())
-            .with_visible_front(law)
+            .with_visible_front(law, 0)
     }
 }
 

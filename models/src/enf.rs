@@ -170,7 +170,7 @@ impl Enf {
     fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
         self.control
             .path(self.max_deflection(law) / scale.displacement, self.effective_crack_length())
-            .with_visible_front(law)
+            .with_visible_front(law, 1)
     }
 }
 

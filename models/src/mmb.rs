@@ -326,7 +326,9 @@ impl Mmb {
     fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale, lever_compliance: f64) -> PathSettings {
         let a = self.effective_crack_length();
         let lever = lever_compliance * self.onset_load(law);
-        self.control.path((self.max_displacement(law) + lever) / scale.displacement, a).with_visible_front(law)
+        // Mixed mode: the segment rule places the visible front at the law's kink whatever the
+        // mode; the opening's damage level serves only measures by damage alone.
+        self.control.path((self.max_displacement(law) + lever) / scale.displacement, a).with_visible_front(law, 0)
     }
 
     /// Engine rows with the lever's stored energy `½ C_lever P²` taken out of the external work and

@@ -68,3 +68,25 @@ fn an_enf_measures_the_matrix_crack_of_a_bridging_law_too() {
         "ENF: P {p0}, {p_small}, {p_large} N; a {a0}, {a_small}, {a_large} mm (ratios {ratio_p}, {ratio_a})"
     );
 }
+
+#[test]
+fn the_visible_front_level_is_the_damage_where_the_matrix_fails_in_the_tests_mode() {
+    use czid_models::fe::crack::visible_front_level;
+    use czid_models::laws::Bridging;
+    // Matrix 30 / 45 MPa, 0.25 / 0.8 N/mm; tail 3 / 4.5 MPa, 0.5 / 1.0 N/mm; penalties split
+    // in the ratio of the strengths (1e5 in all).
+    let law = Bridging::trilinear(1e5, [30.0, 45.0, 0.25, 0.8], [3.0, 4.5, 0.5, 1.0], 2.0).unwrap();
+    let k_tail = 1e5 * 3.0 / 33.0;
+    // Where the matrix fails (δ_c = 2 G / σ) the tail, on its linear softening branch, carries
+    // t_b = σ_b (δ_f − δ_c) / (δ_f − δ_0), and the combined damage is 1 − t_b / (K δ_c).
+    let level = |sigma_m: f64, g_m: f64, sigma_b: f64, g_b: f64| {
+        let dc = 2.0 * g_m / sigma_m;
+        let (d0, df) = (sigma_b / k_tail, 2.0 * g_b / sigma_b);
+        1.0 - sigma_b * (df - dc) / (df - d0) / (1e5 * dc)
+    };
+    let (opening, slip) = (visible_front_level(&law, 0).unwrap(), visible_front_level(&law, 1).unwrap());
+    assert!((opening - level(30.0, 0.25, 3.0, 0.5)).abs() < 1e-9, "opening: {opening}");
+    assert!((slip - level(45.0, 0.8, 4.5, 1.0)).abs() < 1e-9, "slip: {slip}");
+    // A law without a visible front other than complete failure has none.
+    assert_eq!(visible_front_level(&Bilinear::bk(1e5, 30.0, 45.0, 0.25, 0.8, 2.0).unwrap(), 0), None);
+}

@@ -165,12 +165,12 @@ pub enum Debonded {
 }
 
 /// The damage level of the law's visible front ([`CohesiveLaw::visible_front_kink`]) for crack
-/// measures that place fronts by damage alone: the damage just beyond the kink in opening, kept
-/// below [`FAILURE_LEVEL`] (a level from there on means complete failure); `None` if the visible
-/// crack is complete failure.
-pub fn visible_front_level(law: &dyn CohesiveLaw) -> Option<f64> {
+/// measures that place fronts by damage alone: the damage just beyond the kink in the test's
+/// mode (`mode` 0: opening, as in a DCB; 1: slip, as in an ENF), kept below [`FAILURE_LEVEL`] (a
+/// level from there on means complete failure); `None` if the visible crack is complete failure.
+pub fn visible_front_level(law: &dyn CohesiveLaw, mode: usize) -> Option<f64> {
     let k = law.visible_front_kink()?;
-    super::segment::inner_kink_damage(law, k).map(|d| d.min(1.0 - 1.0001e-6))
+    super::segment::inner_kink_damage(law, k, mode).map(|d| d.min(1.0 - 1.0001e-6))
 }
 
 /// Crack measures from the interface segments ([`super::segment`]) and the fronts the last

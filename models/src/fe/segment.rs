@@ -544,10 +544,23 @@ fn front_where(
     Some(if from == 0.0 { s } else { 1.0 - s })
 }
 
-/// Damage just beyond the law's inner kink `k` in pure opening: the level at which models that
-/// measure a crack by damage alone place a front at that kink (`None` if the law has no such
-/// kink in opening).
-pub fn inner_kink_damage(law: &dyn CohesiveLaw, k: usize) -> Option<f64> {
-    let (g, _, _) = ModeOne::of(law)?.inner.get(k).copied().flatten()?;
-    Some(law.evaluate(&Gap::new(next_up(g), 0.0), &law.initial_state()).state.damage)
+/// Damage just beyond the law's inner kink `k` along a pure-mode path (`mode` 0: opening, 1:
+/// slip): the level at which models that measure a crack by damage alone place a front at that
+/// kink (`None` if the path never passes it).
+pub fn inner_kink_damage(law: &dyn CohesiveLaw, k: usize, mode: usize) -> Option<f64> {
+    let init = law.initial_state();
+    let at = |g: f64| law.evaluate(&if mode == 0 { Gap::new(g, 0.0) } else { Gap::new(0.0, g) }, &init);
+    let beyond = |g: f64| law.beyond_inner_kink(&at(g).state, k);
+    let [kn, kt] = law.initial_stiffness();
+    let (stiffness, strength) = (if mode == 0 { kn } else { kt }, law.strength()[mode.min(1)]);
+    // From the elastic limit (or a micrometre), doubling until past the kink.
+    let mut hi = if stiffness > 0.0 && strength > 0.0 { strength / stiffness } else { 1e-3 };
+    for _ in 0..80 {
+        if beyond(hi) {
+            let g = bisect(0.0, hi, beyond);
+            return Some(at(next_up(g)).state.damage);
+        }
+        hi *= 2.0;
+    }
+    None
 }
