@@ -221,7 +221,7 @@ impl Dcb2d {
         let zone = self.cohesive_zone_length(law);
         let margin = (2.0 * self.mesh.interface_element).max(if zone.is_finite() { zone } else { 0.0 });
         let threshold = match crate::fe::crack::visible_front_level(law, 0) {
-            Some(level) if self.control.damage_threshold >= 1.0 - 1.0001e-6 => level,
+            Some(level) if self.control.damage_threshold >= crate::fe::crack::BELOW_FAILURE => level,
             _ => self.control.damage_threshold,
         };
         PathSettings {

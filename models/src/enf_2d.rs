@@ -219,7 +219,7 @@ impl Enf2d {
 
     fn settings(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
         let threshold = match crate::fe::crack::visible_front_level(law, 1) {
-            Some(level) if self.control.damage_threshold >= 1.0 - 1.0001e-6 => level,
+            Some(level) if self.control.damage_threshold >= crate::fe::crack::BELOW_FAILURE => level,
             _ => self.control.damage_threshold,
         };
         PathSettings {

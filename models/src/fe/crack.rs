@@ -154,6 +154,10 @@ pub fn measure_located(
 /// it lies within 10⁻⁹ of the opening where the damage reaches `1 − 10⁻⁹`).
 pub const FAILURE_LEVEL: f64 = 1.0 - 1e-6;
 
+/// The highest damage level that still means a front before complete failure: a visible front's
+/// level is kept at or below it, and a threshold at or above it is left to the visible front.
+pub const BELOW_FAILURE: f64 = 1.0 - 1.0001e-6;
+
 /// What a crack measure counts as debonded.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Debonded {
@@ -170,7 +174,7 @@ pub enum Debonded {
 /// level from there on means complete failure); `None` if the visible crack is complete failure.
 pub fn visible_front_level(law: &dyn CohesiveLaw, mode: usize) -> Option<f64> {
     let k = law.visible_front_kink()?;
-    super::segment::inner_kink_damage(law, k, mode).map(|d| d.min(1.0 - 1.0001e-6))
+    super::segment::inner_kink_damage(law, k, mode).map(|d| d.min(BELOW_FAILURE))
 }
 
 /// Crack measures from the interface segments ([`super::segment`]) and the fronts the last

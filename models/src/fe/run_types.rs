@@ -56,7 +56,7 @@ impl PathSettings {
     /// fibres: what a camera sees) when that lies before complete failure, in a test of the mode
     /// `mode` (0: opening, 1: slip). A threshold below complete failure that the user chose stays.
     pub fn with_visible_front(mut self, law: &dyn czid_core::CohesiveLaw, mode: usize) -> Self {
-        if self.damage_threshold >= 1.0 - 1.0001e-6 {
+        if self.damage_threshold >= super::crack::BELOW_FAILURE {
             if let Some(level) = super::crack::visible_front_level(law, mode) {
                 self.damage_threshold = level;
                 self.visible_kink = law.visible_front_kink();

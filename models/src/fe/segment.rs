@@ -163,31 +163,18 @@ impl ModeOne {
         }
         let at_onset = law.evaluate(&Gap::new(onset, 0.0), &init);
         let gc = law.fracture_energy()[0];
-        let mut hi = if gc > 0.0 && s > 0.0 { (2.0 * gc / s).max(2.0 * onset) } else { 2.0 * onset };
-        let mut failure = None;
-        for _ in 0..80 {
-            if damage(hi) >= 1.0 {
-                failure = Some(bisect(onset, hi, |g| damage(g) >= 1.0));
-                break;
-            }
-            hi *= 2.0;
-        }
+        let hi = if gc > 0.0 && s > 0.0 { (2.0 * gc / s).max(2.0 * onset) } else { 2.0 * onset };
+        let failure = bracket_and_bisect(onset, hi, |g| damage(g) >= 1.0);
         // Failed side of the front (the bisection returns the last opening below it).
         let at_failure = failure.map(|g| law.evaluate(&Gap::new(next_up(g), 0.0), &init));
         let inner_count = law.inner_kinks().min(MAX_INNER_KINKS);
         let mut inner = [None; MAX_INNER_KINKS];
         for (k, slot) in inner.iter_mut().enumerate().take(inner_count) {
             let beyond = |g: f64| law.beyond_inner_kink(&law.evaluate(&Gap::new(g, 0.0), &init).state, k);
-            let mut hi = 2.0 * onset;
-            for _ in 0..80 {
-                if beyond(hi) {
-                    let g = bisect(onset, hi, beyond);
-                    let e = law.evaluate(&Gap::new(next_up(g), 0.0), &init);
-                    *slot = Some((g, e.traction, e.tangent));
-                    break;
-                }
-                hi *= 2.0;
-            }
+            *slot = bracket_and_bisect(onset, 2.0 * onset, beyond).map(|g| {
+                let e = law.evaluate(&Gap::new(next_up(g), 0.0), &init);
+                (g, e.traction, e.tangent)
+            });
         }
         Some(ModeOne {
             onset,
@@ -200,6 +187,18 @@ impl ModeOne {
             inner_count,
         })
     }
+}
+
+/// [`bisect`] on `[lo, hi]` after doubling `hi` (up to 80 times) until `beyond(hi)`; `None` if
+/// it never is.
+fn bracket_and_bisect(lo: f64, mut hi: f64, beyond: impl Fn(f64) -> bool) -> Option<f64> {
+    for _ in 0..80 {
+        if beyond(hi) {
+            return Some(bisect(lo, hi, beyond));
+        }
+        hi *= 2.0;
+    }
+    None
 }
 
 /// The point of `[lo, hi]` where `beyond` switches from false (at `lo`) to true (at `hi`), to
@@ -553,14 +552,7 @@ pub fn inner_kink_damage(law: &dyn CohesiveLaw, k: usize, mode: usize) -> Option
     let beyond = |g: f64| law.beyond_inner_kink(&at(g).state, k);
     let [kn, kt] = law.initial_stiffness();
     let (stiffness, strength) = (if mode == 0 { kn } else { kt }, law.strength()[mode.min(1)]);
-    // From the elastic limit (or a micrometre), doubling until past the kink.
-    let mut hi = if stiffness > 0.0 && strength > 0.0 { strength / stiffness } else { 1e-3 };
-    for _ in 0..80 {
-        if beyond(hi) {
-            let g = bisect(0.0, hi, beyond);
-            return Some(at(next_up(g)).state.damage);
-        }
-        hi *= 2.0;
-    }
-    None
+    // From the elastic limit (or a micrometre) on.
+    let hi = if stiffness > 0.0 && strength > 0.0 { strength / stiffness } else { 1e-3 };
+    bracket_and_bisect(0.0, hi, beyond).map(|g| at(next_up(g)).state.damage)
 }
