@@ -92,7 +92,15 @@ fn compare(title: &str, beam: Dcb, continuum: Dcb2d, law: &dyn CohesiveLaw, at: 
             b.control.output_points = 2;
             b.simulate(law).ok().map(|r| figures(&r, 0.0).compliance)
         };
-        let Some(v) = bisect(|v| initial(v).map(|c| c - reference.compliance), 0.0, 2e-3) else {
+        // Up to the largest root compliance the law accepts in series (beyond it the run is refused).
+        let hi = match effect {
+            "root_compliance" => {
+                czid_models::effects::ROOT_COMPLIANCE_SHARE
+                    / (2.0 * czid_models::effects::steepest_mode_one_softening(law))
+            }
+            _ => 2e-3,
+        };
+        let Some(v) = bisect(|v| initial(v).map(|c| c - reference.compliance), 0.0, hi) else {
             println!("| beam + {effect} | no size matches the continuum's compliance | | |");
             continue;
         };

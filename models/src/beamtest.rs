@@ -315,20 +315,17 @@ pub fn to_record(rows: &[StepRow], s: &RowScale) -> Record {
 }
 
 /// The interface of two arms (layer 0 below, layer 1 above) on nodes `0..=last`, cracked up to
-/// node `tip`: contact points (frictionless unless the problem sets `contact_friction`) on the cracked faces, cohesive points from the crack
-/// front on (the front node carries both, each with its side's tributary length), and with a
-/// root compliance `root_compliance > 0` (mm/MPa) a through-thickness spring of each arm's surface
-/// at every bonded node (the layers must carry surface unknowns there).
+/// node `tip`: contact points (frictionless unless the problem sets `contact_friction`) on the
+/// cracked faces, and cohesive points from the crack front on (the front node carries both, each
+/// with its side's tributary length).
 pub fn cracked_arms_interface(
     mesh: &crate::fe::Mesh,
     tip: usize,
     last: usize,
     width: f64,
-    root_compliance: f64,
-) -> (Vec<crate::fe::InterfacePoint>, Vec<crate::fe::Spring>) {
-    use crate::fe::{InterfacePoint, PointKind, Spring};
+) -> Vec<crate::fe::InterfacePoint> {
+    use crate::fe::{InterfacePoint, PointKind};
     let mut points = Vec::with_capacity(last + 2);
-    let mut springs = Vec::new();
     for i in 0..=last {
         let left = if i > 0 { 0.5 * (mesh.x[i] - mesh.x[i - 1]) } else { 0.0 };
         let right = if i < last { 0.5 * (mesh.x[i + 1] - mesh.x[i]) } else { 0.0 };
@@ -341,19 +338,8 @@ pub fn cracked_arms_interface(
         } else {
             points.push(pt(width * (left + right), PointKind::Cohesive));
         }
-        if root_compliance > 0.0 && i >= tip {
-            let area = width * (if i == tip { right } else { left + right });
-            for layer in 0..2 {
-                springs.push(Spring {
-                    i: mesh.dofs(layer, i)[3],
-                    j: crate::fe::mesh::NONE,
-                    k: area / root_compliance,
-                    ci: 1.0,
-                });
-            }
-        }
     }
-    (points, springs)
+    points
 }
 
 /// Checks what the split beams on two supports (ENF, MMB) share: no large rotations, and the

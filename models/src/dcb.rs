@@ -39,8 +39,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::beamtest::{self, ControlSettings, Material, MeshSettings, RowScale};
 use crate::effects::Effects;
-use crate::fe::mesh::{graded, NONE};
-use crate::fe::{self, FeProblem, InterfacePoint, Layer, Mesh, PathSettings, PointKind, Section, Spring};
+use crate::fe::mesh::graded;
+use crate::fe::{self, FeProblem, InterfacePoint, Layer, Mesh, PathSettings, PointKind, Section};
 use crate::measurement::{recorded_control, LoadPoint};
 
 /// Half (symmetric) or full (two-arm) model.
@@ -240,24 +240,15 @@ impl Dcb {
         let nn = x.len();
         let tip = x.iter().position(|&v| (v - a).abs() <= 1e-9 * self.length).unwrap_or(0);
         let large = fx.large_rotation;
-        let surface = (fx.root_compliance > 0.0).then_some((tip, nn - 1));
         let extra = crate::measurement::extra_unknowns(fx.machine_compliance, true);
         let half = self.symmetry == Symmetry::Half;
         let (layers, factor) = if half {
-            let up =
-                Layer { section: self.section(self.h), y: 0.5 * self.h, axial: large, first: 0, last: nn - 1, surface };
+            let up = Layer { section: self.section(self.h), y: 0.5 * self.h, axial: large, first: 0, last: nn - 1 };
             (vec![up], 0.5)
         } else {
             let hl = self.h_lower.unwrap_or(self.h);
-            let lo = Layer { section: self.section(hl), y: 0.5 * hl, axial: true, first: 0, last: nn - 1, surface };
-            let up = Layer {
-                section: self.section(self.h),
-                y: hl + 0.5 * self.h,
-                axial: true,
-                first: 0,
-                last: nn - 1,
-                surface,
-            };
+            let lo = Layer { section: self.section(hl), y: 0.5 * hl, axial: true, first: 0, last: nn - 1 };
+            let up = Layer { section: self.section(self.h), y: hl + 0.5 * self.h, axial: true, first: 0, last: nn - 1 };
             (vec![lo, up], 1.0)
         };
         let mesh = Mesh::new(x, layers, extra)?;
@@ -276,12 +267,6 @@ impl Dcb {
                 factor,
                 kind: PointKind::Cohesive,
             });
-            if fx.root_compliance > 0.0 {
-                // Through-thickness spring of each arm (whole arm in the half model too).
-                for l in 0..mesh.layers.len() {
-                    springs.push(Spring { i: mesh.dofs(l, i)[3], j: NONE, k: area / fx.root_compliance, ci: 1.0 });
-                }
-            }
         }
         let mut fixed = Vec::new();
         let w_up = mesh.dofs(upper, 0)[1];
@@ -374,6 +359,8 @@ impl ForwardModel for Dcb {
         let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
         law.validate().map_err(fail)?;
         self.effects.check_root_compliance("dcb", law).map_err(fail)?;
+        let series = self.effects.interface_law(law).map_err(fail)?;
+        let law = series.as_ref().map_or(law, |s| s as &dyn CohesiveLaw);
         let (p, scale) = self.problem().map_err(fail)?;
         let path = self.path(law, &scale);
         match beamtest::run(&p, law, &path, &RUN, &scale) {
@@ -394,6 +381,8 @@ pub fn simulate_with_stats(dcb: &Dcb, law: &dyn CohesiveLaw) -> Result<(Record, 
 pub fn simulate_with_options(dcb: &Dcb, law: &dyn CohesiveLaw, run: &fe::RunOptions) -> Result<(Record, fe::RunStats)> {
     law.validate()?;
     dcb.effects.check_root_compliance("dcb", law)?;
+    let series = dcb.effects.interface_law(law)?;
+    let law = series.as_ref().map_or(law, |s| s as &dyn CohesiveLaw);
     let (p, scale) = dcb.problem()?;
     let path = dcb.path(law, &scale);
     beamtest::run(&p, law, &path, run, &scale).map_err(|f| f.error)

@@ -138,13 +138,12 @@ impl Enf {
         let nn = x.len();
         let tip = x.iter().position(|&v| (v - a).abs() <= 1e-9 * l).unwrap_or(0);
         let mid = x.iter().position(|&v| (v - l).abs() <= 1e-9 * l).unwrap_or(nn / 2);
-        let surface = (fx.root_compliance > 0.0).then_some((tip, nn - 1));
         let s = self.section();
-        let lo = Layer { section: s, y: 0.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
-        let up = Layer { section: s, y: 1.5 * self.h, axial: true, first: 0, last: nn - 1, surface };
+        let lo = Layer { section: s, y: 0.5 * self.h, axial: true, first: 0, last: nn - 1 };
+        let up = Layer { section: s, y: 1.5 * self.h, axial: true, first: 0, last: nn - 1 };
         let mesh = Mesh::new(x, vec![lo, up], crate::measurement::extra_unknowns(fx.machine_compliance, false))?;
-        let (points, mut springs) =
-            beamtest::cracked_arms_interface(&mesh, tip, nn - 1, self.width, fx.root_compliance);
+        let points = beamtest::cracked_arms_interface(&mesh, tip, nn - 1, self.width);
+        let mut springs = Vec::new();
         let fixed = vec![mesh.dofs(0, 0)[1], mesh.dofs(0, nn - 1)[1], mesh.dofs(0, nn - 1)[0]];
         let w_load = mesh.dofs(1, mid)[1];
         // The load nose pushes the upper arm down: recorded deflection and load are positive.
@@ -204,6 +203,8 @@ impl ForwardModel for Enf {
         let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
         law.validate().map_err(fail)?;
         let (p, scale) = self.problem(law).map_err(fail)?;
+        let series = self.effects.interface_law(law).map_err(fail)?;
+        let law = series.as_ref().map_or(law, |s| s as &dyn CohesiveLaw);
         let path = self.path(law, &scale);
         beamtest::run(&p, law, &path, &RUN, &scale).map(|(record, _)| record)
     }
@@ -213,6 +214,8 @@ impl ForwardModel for Enf {
 pub fn simulate_with_stats(enf: &Enf, law: &dyn CohesiveLaw) -> Result<(Record, fe::RunStats)> {
     law.validate()?;
     let (p, scale) = enf.problem(law)?;
+    let series = enf.effects.interface_law(law)?;
+    let law = series.as_ref().map_or(law, |s| s as &dyn CohesiveLaw);
     let path = enf.path(law, &scale);
     beamtest::run(&p, law, &path, &RUN, &scale).map_err(|f| f.error)
 }

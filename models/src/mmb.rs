@@ -270,17 +270,17 @@ impl Mmb {
         let x = self.grid();
         let at = |v: f64| x.iter().position(|&xi| (xi - v).abs() <= 1e-9 * l).unwrap_or(0);
         let (tip, mid, end) = (at(a), at(l), at(2.0 * l));
-        let surface = (fx.root_compliance > 0.0).then_some((tip, end));
         let s = self.arm_section();
-        let lo = Layer { section: s, y: 0.5 * self.h, axial: true, first: 0, last: end, surface };
-        let up = Layer { section: s, y: 1.5 * self.h, axial: true, first: 0, last: end, surface };
+        let lo = Layer { section: s, y: 0.5 * self.h, axial: true, first: 0, last: end };
+        let up = Layer { section: s, y: 1.5 * self.h, axial: true, first: 0, last: end };
         // The lever's carrier: no stiffness of its own; at every node its "deflection" unknown is
         // the lever's deflection t at the hinge and its "rotation" unknown the deflection u of the
         // lever's load point.
         let none = Section { e: 0.0, g: 0.0, b: s.b, h: s.h };
-        let lever = Layer { section: none, y: 3.0 * self.h, axial: false, first: 0, last: mid, surface: None };
+        let lever = Layer { section: none, y: 3.0 * self.h, axial: false, first: 0, last: mid };
         let mesh = Mesh::new(x, vec![lo, up, lever], crate::measurement::extra_unknowns(fx.machine_compliance, false))?;
-        let (points, mut springs) = beamtest::cracked_arms_interface(&mesh, tip, end, self.width, fx.root_compliance);
+        let points = beamtest::cracked_arms_interface(&mesh, tip, end, self.width);
+        let mut springs = Vec::new();
         let (k, kr) = self.tie_stiffness(mid);
         let t = |node: usize| mesh.dofs(2, node)[1];
         let u = |node: usize| mesh.dofs(2, node)[2];
@@ -353,11 +353,13 @@ impl Mmb {
     /// Builds the problem once and runs it: the scaling of its rows (`None` when the problem could
     /// not be built), and the specimen's rows and statistics, or on failure its converged rows.
     fn run(&self, law: &dyn CohesiveLaw) -> (Option<RowScale>, EngineRun) {
-        let built = law.validate().and_then(|_| self.build(law));
-        let (p, scale, cl) = match built {
+        let built =
+            law.validate().and_then(|_| self.build(law)).and_then(|b| Ok((b, self.effects.interface_law(law)?)));
+        let ((p, scale, cl), series) = match built {
             Ok(b) => b,
             Err(error) => return (None, Err(fe::PathFailure { error, rows: Vec::new() })),
         };
+        let law = series.as_ref().map_or(law, |s| s as &dyn CohesiveLaw);
         let path = self.path(law, &scale, cl);
         let run = match fe::run_with(&p, law, &path, &RUN) {
             Ok((rows, stats)) => Ok((Self::specimen_rows(&rows, cl), stats)),

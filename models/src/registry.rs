@@ -7,7 +7,7 @@
 use czid_core::{CohesiveLaw, ForwardModel};
 
 /// `type` names of the bundled cohesive laws.
-pub const LAW_TYPES: &[&str] = &["st_czm", "bilinear", "exponential", "bridging", "lu_bond_slip"];
+pub const LAW_TYPES: &[&str] = &["st_czm", "bilinear", "exponential", "bridging", "lu_bond_slip", "series_compliance"];
 /// `type` names of the bundled forward models.
 pub const MODEL_TYPES: &[&str] = &["dcb", "enf", "frp_pull", "frp_beam", "dcb_2d", "enf_2d", "mmb"];
 
@@ -21,6 +21,7 @@ pub fn ensure_linked() {
     std::hint::black_box(<crate::laws::Exponential as CohesiveLaw>::validate as fn(&_) -> _);
     std::hint::black_box(<crate::laws::Bridging as CohesiveLaw>::validate as fn(&_) -> _);
     std::hint::black_box(<crate::laws::LuBondSlip as CohesiveLaw>::validate as fn(&_) -> _);
+    std::hint::black_box(<crate::laws::SeriesCompliance as CohesiveLaw>::validate as fn(&_) -> _);
     std::hint::black_box(<crate::dcb::Dcb as ForwardModel>::validate as fn(&_) -> _);
     std::hint::black_box(<crate::enf::Enf as ForwardModel>::validate as fn(&_) -> _);
     std::hint::black_box(<crate::frp::pull::FrpPull as ForwardModel>::validate as fn(&_) -> _);

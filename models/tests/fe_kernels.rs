@@ -6,7 +6,7 @@
 
 use czid_models::fe::banded::BandMatrix;
 use czid_models::fe::corotational;
-use czid_models::fe::interface::{kinematics, InterfacePoint, PointKind};
+use czid_models::fe::interface::{kinematics, InterfacePoint, PointKind, POINT_DOFS};
 use czid_models::fe::mesh::{Layer, Mesh, Section};
 
 #[test]
@@ -34,13 +34,13 @@ fn corotational_forces_and_tangent_match_finite_differences() {
 fn large_rotation_gap_derivatives_match_finite_differences() {
     let s = Section { e: 20_000.0, g: 2_000.0, b: 25.0, h: 2.7 };
     let layers = vec![
-        Layer { section: s, y: 1.35, axial: true, first: 0, last: 1, surface: Some((0, 1)) },
-        Layer { section: s, y: 4.05, axial: true, first: 0, last: 1, surface: Some((0, 1)) },
+        Layer { section: s, y: 1.35, axial: true, first: 0, last: 1 },
+        Layer { section: s, y: 4.05, axial: true, first: 0, last: 1 },
     ];
     let mesh = Mesh::new(vec![0.0, 1.0], layers, 0).unwrap();
     let n = mesh.n_dofs();
     let q: Vec<f64> = (0..n).map(|i| 0.05 * ((i as f64) * 1.7).sin()).collect();
-    let mut hess = [[[0.0; 8]; 8]; 2];
+    let mut hess = [[[0.0; POINT_DOFS]; POINT_DOFS]; 2];
     for lower in [Some(0), None] {
         let pt = InterfacePoint { node: 0, upper: 1, lower, area: 1.0, factor: 1.0, kind: PointKind::Cohesive };
         let k = kinematics(&mesh, &pt, &q, true, &mut hess);
@@ -59,7 +59,7 @@ fn large_rotation_gap_derivatives_match_finite_differences() {
                 assert!((fd - k.grad[c][a]).abs() < 1e-8, "grad {c} {a}");
                 // (On a symmetry plane only the upper side's block is written: the lower side
                 // has no unknowns.)
-                for b in (0..8).filter(|&b| k.dofs[b] != usize::MAX) {
+                for b in (0..POINT_DOFS).filter(|&b| k.dofs[b] != usize::MAX) {
                     let fdh = (kp.grad[c][b] - km.grad[c][b]) / (2.0 * h);
                     assert!((fdh - h0[c][b][a]).abs() < 1e-6, "hess {c} {b} {a}: {fdh} vs {}", h0[c][b][a]);
                 }

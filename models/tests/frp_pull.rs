@@ -437,7 +437,7 @@ fn elastic_concrete_equals_a_two_layer_model_with_a_concrete_layer() {
     let (length, h) = (400.0, 4.0);
     let n = (length / h) as usize;
     let x = fe::mesh::uniform(0.0, length, n);
-    let bar = |section: Section, y: f64| Layer { section, y, axial: true, first: 0, last: n, surface: None };
+    let bar = |section: Section, y: f64| Layer { section, y, axial: true, first: 0, last: n };
     let concrete = bar(Section { e: ec(), g: ec(), b: BC, h: HC }, 0.5 * HC);
     let plate = bar(Section { e: EF, g: EF, b: BF, h: TF }, HC + 0.5 * TF);
     let mesh = Mesh::new(x, vec![concrete, plate], 0).unwrap();

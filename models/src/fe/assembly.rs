@@ -16,7 +16,7 @@ use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent};
 use super::banded::BandMatrix;
 use super::beam;
 use super::corotational;
-use super::interface::{self, GapKinematics, InterfacePoint, PointKind};
+use super::interface::{self, GapKinematics, InterfacePoint, PointKind, POINT_DOFS, SIDE};
 use super::mesh::{Mesh, NONE};
 use super::segment::{self, End, ModeOne, Segment};
 
@@ -100,13 +100,14 @@ pub enum InterfaceRule {
 struct PointData {
     kin: GapKinematics,
     d: Tangent,
-    /// The unknowns are among `kin.dofs[first..]`: 4 on a symmetry plane (no lower side), else 0.
+    /// The unknowns are among `kin.dofs[first..]`: [`SIDE`] on a symmetry plane (no lower side),
+    /// else 0.
     first: usize,
 }
 
 impl PointData {
     fn new(kin: GapKinematics, d: Tangent) -> Self {
-        let first = if kin.dofs[..4].iter().all(|&d| d == NONE) { 4 } else { 0 };
+        let first = if kin.dofs[..SIDE].iter().all(|&d| d == NONE) { SIDE } else { 0 };
         PointData { kin, d, first }
     }
 }
@@ -209,16 +210,16 @@ impl Assembler {
             covered,
             mode_one,
             data: vec![PointData::default(); np],
-            hessians: if large { vec![[[[0.0; 8]; 8]; 2]; np] } else { Vec::new() },
+            hessians: if large { vec![[[[0.0; POINT_DOFS]; POINT_DOFS]; 2]; np] } else { Vec::new() },
             at_rest: if p.large_rotation {
                 Vec::new()
             } else {
-                let (zero, mut hess) = (vec![0.0; n], [[[0.0; 8]; 8]; 2]);
+                let (zero, mut hess) = (vec![0.0; n], [[[0.0; POINT_DOFS]; POINT_DOFS]; 2]);
                 p.points.iter().map(|pt| interface::kinematics(mesh, pt, &zero, false, &mut hess)).collect()
             },
             n,
             strength,
-            hess: Box::new([[[0.0; 8]; 8]; 2]),
+            hess: Box::new([[[0.0; POINT_DOFS]; POINT_DOFS]; 2]),
             frozen_from_node: usize::MAX,
         }
     }
@@ -321,7 +322,7 @@ impl Assembler {
             let w = pt.area * pt.factor;
             // f += w Gᵀ T ; K += w (Gᵀ D G + T_n H_n + T_t H_t)
             let g = &kin.grad;
-            for a in 0..8 {
+            for a in 0..POINT_DOFS {
                 let da = kin.dofs[a];
                 if da == NONE || (g[0][a] == 0.0 && g[1][a] == 0.0 && !kin.nonlinear) {
                     continue;
@@ -330,7 +331,7 @@ impl Assembler {
                 // Row a of Gᵀ D: (g0a D00 + g1a D10, g0a D01 + g1a D11)
                 let ra0 = g[0][a] * d[(0, 0)] + g[1][a] * d[(1, 0)];
                 let ra1 = g[0][a] * d[(0, 1)] + g[1][a] * d[(1, 1)];
-                for b in 0..8 {
+                for b in 0..POINT_DOFS {
                     let db = kin.dofs[b];
                     if db == NONE {
                         continue;
@@ -362,8 +363,8 @@ impl Assembler {
             let pts = [&self.data[sg.a], &self.data[sg.b]];
             let hess = [self.hessians.get(sg.a), self.hessians.get(sg.b)];
             // Both points on a symmetry plane (a half DCB): only their upper sides have unknowns.
-            if pts[0].first == 4 && pts[1].first == 4 {
-                add_segment::<4>(k, f, pts, hess, &sf);
+            if pts[0].first == SIDE && pts[1].first == SIDE {
+                add_segment::<SIDE>(k, f, pts, hess, &sf);
             } else {
                 add_segment::<0>(k, f, pts, hess, &sf);
             }
@@ -440,7 +441,7 @@ fn add_segment<const FIRST: usize>(
     for (i, pi) in pts.iter().enumerate() {
         let ki = &pi.kin;
         let fi = sf.f[i];
-        for r in FIRST..8 {
+        for r in FIRST..POINT_DOFS {
             let dr = ki.dofs[r];
             if dr == NONE {
                 continue;
@@ -457,7 +458,7 @@ fn add_segment<const FIRST: usize>(
                 let ra0 = g0 * jac[(0, 0)] + g1 * jac[(1, 0)];
                 let ra1 = g0 * jac[(0, 1)] + g1 * jac[(1, 1)];
                 let h = if i == j && ki.nonlinear { hess[i] } else { None };
-                for c in FIRST..8 {
+                for c in FIRST..POINT_DOFS {
                     let dc = kj.dofs[c];
                     if dc == NONE {
                         continue;

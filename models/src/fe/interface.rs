@@ -3,9 +3,8 @@
 //! The gap is measured between the bottom surface of the `upper` layer and the top surface of
 //! the `lower` layer (or its mirror image about a symmetry plane), from each layer's section
 //! kinematics: a surface fibre at height `z` above the centroid of a layer with unknowns
-//! `(u, w, θ)` sits at `(X + u − z sin θ, Y + w + z cos θ)`. Where a layer carries the
-//! through-thickness unknown `s` (see [`super::mesh::Layer::surface`]), the surface sits at height
-//! `z + s` instead.
+//! `(u, w, θ)` sits at `(X + u − z sin θ, Y + w + z cos θ)`: the layers are rigid through their
+//! thickness (a through-thickness compliance belongs to the law: [`crate::laws::SeriesCompliance`]).
 //!
 //! **Integration.** Points sit at the mesh nodes and carry the nodal (trapezoidal, i.e.
 //! two-point Newton–Cotes/Lobatto) weights of their neighbouring elements. Nodal integration
@@ -13,7 +12,7 @@
 //! spurious traction oscillations Gauss integration shows ahead of a crack tip (Schellekens &
 //! de Borst 1993), and the law is evaluated once per node rather than twice per element.
 //!
-//! **Small rotations**: `g_n = (w_U + s_U) − (w_L + s_L)`, `g_t = (u_U − z_U θ_U) − (u_L − z_L θ_L)`,
+//! **Small rotations**: `g_n = w_U − w_L`, `g_t = (u_U − z_U θ_U) − (u_L − z_L θ_L)`,
 //! linear in the unknowns. **Large rotations**: the surface points' separation `d` is resolved on
 //! the frame of the mean rotation `θ̄ = (θ_L + θ_U)/2`, `g_n = d·n(θ̄)`, `g_t = d·t(θ̄)`; the Hessians of
 //! `g` give the geometric part of the tangent. On a symmetry plane `g_n` is twice the upper
@@ -51,23 +50,28 @@ pub struct InterfacePoint {
     pub kind: PointKind,
 }
 
+/// Unknowns of one side of a point: its layer's `[u, w, θ]` at the point's node.
+pub const SIDE: usize = 3;
+/// Unknowns of a point: the lower side's, then the upper side's.
+pub const POINT_DOFS: usize = 2 * SIDE;
+
 /// Gap of a point and its derivatives with respect to the point's unknowns
-/// `[u_L, w_L, θ_L, s_L, u_U, w_U, θ_U, s_U]`.
+/// `[u_L, w_L, θ_L, u_U, w_U, θ_U]`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct GapKinematics {
     /// Global indices of the point's unknowns ([`NONE`] where absent).
-    pub dofs: [usize; 8],
+    pub dofs: [usize; POINT_DOFS],
     /// `[g_n, g_t]` (mm).
     pub gap: [f64; 2],
     /// `∂g/∂q`.
-    pub grad: [[f64; 8]; 2],
+    pub grad: [[f64; POINT_DOFS]; 2],
     /// Whether the gap is nonlinear in the unknowns (large rotations: see [`Hessian`]).
     pub nonlinear: bool,
 }
 
 /// `∂²g/∂q²` of a point (large rotations only), kept out of [`GapKinematics`] so the
 /// small-rotation path never touches it.
-pub type Hessian = [[[f64; 8]; 8]; 2];
+pub type Hessian = [[[f64; POINT_DOFS]; POINT_DOFS]; 2];
 
 #[inline]
 fn val(q: &[f64], d: usize) -> f64 {
@@ -79,33 +83,28 @@ fn val(q: &[f64], d: usize) -> f64 {
 }
 
 /// Displacement of a surface point of one side (relative to its undeformed position) and its
-/// first and second derivatives with respect to `[u, w, θ, s]`.
+/// first and second derivatives with respect to `[u, w, θ]`.
 struct Surface {
     p: [f64; 2],
-    dp: [[f64; 4]; 2],
-    d2p: [[[f64; 4]; 4]; 2],
+    dp: [[f64; SIDE]; 2],
+    d2p: [[[f64; SIDE]; SIDE]; 2],
 }
 
-fn surface(q: &[f64], dofs: &[usize; 4], z: f64, large: bool) -> Surface {
-    let (u, w, t, s) = (val(q, dofs[0]), val(q, dofs[1]), val(q, dofs[2]), val(q, dofs[3]));
-    let mut r = Surface { p: [0.0; 2], dp: [[0.0; 4]; 2], d2p: [[[0.0; 4]; 4]; 2] };
+fn surface(q: &[f64], dofs: &[usize; SIDE], z: f64, large: bool) -> Surface {
+    let (u, w, t) = (val(q, dofs[0]), val(q, dofs[1]), val(q, dofs[2]));
+    let mut r = Surface { p: [0.0; 2], dp: [[0.0; SIDE]; 2], d2p: [[[0.0; SIDE]; SIDE]; 2] };
     if large {
         // (d2p stays zero with small rotations)
         let (sn, cs) = t.sin_cos();
-        let ze = z + s;
-        r.p = [u - ze * sn, w + ze * cs - z];
-        r.dp[0] = [1.0, 0.0, -ze * cs, -sn];
-        r.dp[1] = [0.0, 1.0, -ze * sn, cs];
-        r.d2p[0][2][2] = ze * sn;
-        r.d2p[1][2][2] = -ze * cs;
-        r.d2p[0][2][3] = -cs;
-        r.d2p[0][3][2] = -cs;
-        r.d2p[1][2][3] = -sn;
-        r.d2p[1][3][2] = -sn;
+        r.p = [u - z * sn, w + z * cs - z];
+        r.dp[0] = [1.0, 0.0, -z * cs];
+        r.dp[1] = [0.0, 1.0, -z * sn];
+        r.d2p[0][2][2] = z * sn;
+        r.d2p[1][2][2] = -z * cs;
     } else {
         r.p = surface_position(q, dofs, z);
-        r.dp[0] = [1.0, 0.0, -z, 0.0];
-        r.dp[1] = [0.0, 1.0, 0.0, 1.0];
+        r.dp[0] = [1.0, 0.0, -z];
+        r.dp[1] = [0.0, 1.0, 0.0];
     }
     r
 }
@@ -124,34 +123,34 @@ pub fn small_gap(mesh: &Mesh, p: &InterfacePoint, q: &[f64]) -> [f64; 2] {
 
 /// [`surface`]'s displacement alone, small rotations.
 #[inline]
-fn surface_position(q: &[f64], dofs: &[usize; 4], z: f64) -> [f64; 2] {
-    let (u, w, t, s) = (val(q, dofs[0]), val(q, dofs[1]), val(q, dofs[2]), val(q, dofs[3]));
-    [u - z * t, w + s]
+fn surface_position(q: &[f64], dofs: &[usize; SIDE], z: f64) -> [f64; 2] {
+    let (u, w, t) = (val(q, dofs[0]), val(q, dofs[1]), val(q, dofs[2]));
+    [u - z * t, w]
 }
 
 /// Gap kinematics of point `p` at unknowns `q`; with `large`, also the Hessians into `hess`
 /// (on a symmetry plane only the upper side's block, the only one with unknowns).
 pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess: &mut Hessian) -> GapKinematics {
-    let mut k = GapKinematics { dofs: [NONE; 8], ..Default::default() };
+    let mut k = GapKinematics { dofs: [NONE; POINT_DOFS], ..Default::default() };
     let du = mesh.dofs(p.upper, p.node);
-    k.dofs[4..8].copy_from_slice(&du);
+    k.dofs[SIDE..].copy_from_slice(&du);
     let su = surface(q, &du, -0.5 * mesh.layers[p.upper].section.h, large);
     let Some(lo) = p.lower else {
         // Only the upper side's block is written (and read: the lower side has no unknowns).
         if large {
             for side in hess.iter_mut() {
-                for row in &mut side[4..8] {
-                    row[4..8].fill(0.0);
+                for row in &mut side[SIDE..] {
+                    row[SIDE..].fill(0.0);
                 }
             }
         }
         // Mirror image below: d = (0, 2 p_y), frame fixed by symmetry.
         k.gap[0] = 2.0 * su.p[1];
-        for j in 0..4 {
-            k.grad[0][4 + j] = 2.0 * su.dp[1][j];
+        for j in 0..SIDE {
+            k.grad[0][SIDE + j] = 2.0 * su.dp[1][j];
             if large {
-                for m in 0..4 {
-                    hess[0][4 + j][4 + m] = 2.0 * su.d2p[1][j][m];
+                for m in 0..SIDE {
+                    hess[0][SIDE + j][SIDE + m] = 2.0 * su.d2p[1][j][m];
                 }
             }
         }
@@ -159,14 +158,14 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess:
         return k;
     };
     let dl = mesh.dofs(lo, p.node);
-    k.dofs[0..4].copy_from_slice(&dl);
+    k.dofs[..SIDE].copy_from_slice(&dl);
     let sl = surface(q, &dl, 0.5 * mesh.layers[lo].section.h, large);
     let d = [su.p[0] - sl.p[0], su.p[1] - sl.p[1]];
-    let mut dd = [[0.0; 8]; 2];
+    let mut dd = [[0.0; POINT_DOFS]; 2];
     for c in 0..2 {
-        for j in 0..4 {
+        for j in 0..SIDE {
             dd[c][j] = -sl.dp[c][j];
-            dd[c][4 + j] = su.dp[c][j];
+            dd[c][SIDE + j] = su.dp[c][j];
         }
     }
     if !large {
@@ -174,7 +173,7 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess:
         k.grad = [dd[1], dd[0]];
         return k;
     }
-    *hess = [[[0.0; 8]; 8]; 2];
+    *hess = [[[0.0; POINT_DOFS]; POINT_DOFS]; 2];
     let tb = 0.5 * (val(q, dl[2]) + val(q, du[2]));
     let (sb, cb) = tb.sin_cos();
     let n = [-sb, cb];
@@ -182,21 +181,21 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess:
     let gn = n[0] * d[0] + n[1] * d[1];
     let gt = t[0] * d[0] + t[1] * d[1];
     k.gap = [gn, gt];
-    let mut dtb = [0.0; 8];
+    let mut dtb = [0.0; POINT_DOFS];
     dtb[2] = 0.5;
-    dtb[6] = 0.5;
-    let mut nd = [0.0; 8];
-    let mut td = [0.0; 8];
-    for j in 0..8 {
+    dtb[SIDE + 2] = 0.5;
+    let mut nd = [0.0; POINT_DOFS];
+    let mut td = [0.0; POINT_DOFS];
+    for j in 0..POINT_DOFS {
         nd[j] = n[0] * dd[0][j] + n[1] * dd[1][j];
         td[j] = t[0] * dd[0][j] + t[1] * dd[1][j];
         // ∂n/∂θ̄ = −t, ∂t/∂θ̄ = n
         k.grad[0][j] = nd[j] - gt * dtb[j];
         k.grad[1][j] = td[j] + gn * dtb[j];
     }
-    for a in 0..4 {
-        for b in 0..4 {
-            for (off, side, sign) in [(0usize, &sl, -1.0), (4usize, &su, 1.0)] {
+    for a in 0..SIDE {
+        for b in 0..SIDE {
+            for (off, side, sign) in [(0usize, &sl, -1.0), (SIDE, &su, 1.0)] {
                 let (vx, vy) = (sign * side.d2p[0][a][b], sign * side.d2p[1][a][b]);
                 hess[0][off + a][off + b] += n[0] * vx + n[1] * vy;
                 hess[1][off + a][off + b] += t[0] * vx + t[1] * vy;
@@ -204,8 +203,8 @@ pub fn kinematics(mesh: &Mesh, p: &InterfacePoint, q: &[f64], large: bool, hess:
         }
     }
     // ∂²n/∂θ̄² = −n, ∂²t/∂θ̄² = −t
-    for i in 0..8 {
-        for j in 0..8 {
+    for i in 0..POINT_DOFS {
+        for j in 0..POINT_DOFS {
             hess[0][i][j] += -td[i] * dtb[j] - dtb[i] * td[j] - gn * dtb[i] * dtb[j];
             hess[1][i][j] += nd[i] * dtb[j] + dtb[i] * nd[j] - gt * dtb[i] * dtb[j];
         }

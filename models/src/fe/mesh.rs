@@ -57,10 +57,6 @@ pub struct Layer {
     pub first: usize,
     /// Last node of the layer (inclusive).
     pub last: usize,
-    /// Nodes `surface.0 ..= surface.1` carry a through-thickness unknown `s`: the normal
-    /// displacement of the layer's interface surface relative to its section (used when the
-    /// adherend's through-thickness compliance is modelled). `None`: rigid through the thickness.
-    pub surface: Option<(usize, usize)>,
 }
 
 /// Nodes, layers and the numbering of unknowns.
@@ -72,7 +68,7 @@ pub struct Mesh {
     pub layers: Vec<Layer>,
     /// Extra scalar unknowns numbered first (e.g. an actuator behind a machine spring).
     pub extra: usize,
-    dofs: Vec<[usize; 4]>,
+    dofs: Vec<[usize; 3]>,
     n_dofs: usize,
     bandwidth: usize,
 }
@@ -92,7 +88,7 @@ impl Mesh {
             }
         }
         let nl = layers.len();
-        let mut dofs = vec![[NONE; 4]; nl * x.len()];
+        let mut dofs = vec![[NONE; 3]; nl * x.len()];
         let mut next = extra;
         let mut max_per_node = 0;
         for i in 0..x.len() {
@@ -109,10 +105,6 @@ impl Mesh {
                 d[1] = next;
                 d[2] = next + 1;
                 next += 2;
-                if l.surface.is_some_and(|(a, b)| i >= a && i <= b) {
-                    d[3] = next;
-                    next += 1;
-                }
             }
             max_per_node = max_per_node.max(next - start);
         }
@@ -122,9 +114,9 @@ impl Mesh {
         Ok(Mesh { x, layers, extra, dofs, n_dofs: next, bandwidth })
     }
 
-    /// Unknowns `[u, w, θ, s]` of `layer` at `node` ([`NONE`] where absent).
+    /// Unknowns `[u, w, θ]` of `layer` at `node` ([`NONE`] where absent).
     #[inline]
-    pub fn dofs(&self, layer: usize, node: usize) -> [usize; 4] {
+    pub fn dofs(&self, layer: usize, node: usize) -> [usize; 3] {
         self.dofs[node * self.layers.len() + layer]
     }
 

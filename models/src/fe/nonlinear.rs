@@ -51,7 +51,7 @@ use super::beam;
 use super::crack::{self, CrackMeasures};
 use super::energy::path_work;
 use super::fibre::{self, FibreSection};
-use super::interface::{self, InterfacePoint, PointKind};
+use super::interface::{self, InterfacePoint, PointKind, POINT_DOFS};
 use super::mesh::{Mesh, NONE};
 use super::newton::NewtonSettings;
 use super::segment;
@@ -415,7 +415,7 @@ impl<'a> Solver<'a> {
         };
         let section_tangents = vec![[[0.0; 2]; 2]; fibre_elements.len()];
         let zero = vec![0.0; n];
-        let mut hess = [[[0.0; 8]; 8]; 2];
+        let mut hess = [[[0.0; POINT_DOFS]; POINT_DOFS]; 2];
         let kinematics = p.points.iter().map(|pt| interface::kinematics(mesh, pt, &zero, false, &mut hess)).collect();
         let mut fixed_mask = vec![false; n];
         for &d in &p.fixed {
@@ -584,7 +584,7 @@ impl<'a> Solver<'a> {
             self.iteration_tangents[ip] = d;
             let w = pt.area * pt.factor;
             let g = &kin.grad;
-            for a in 0..8 {
+            for a in 0..POINT_DOFS {
                 let da = kin.dofs[a];
                 if da != NONE && (g[0][a] != 0.0 || g[1][a] != 0.0) {
                     self.f[da] += w * (g[0][a] * t[0] + g[1][a] * t[1]);
@@ -630,14 +630,14 @@ impl<'a> Solver<'a> {
         for ((pt, kin), d) in self.p.points.iter().zip(&self.kinematics).zip(&self.iteration_tangents) {
             let w = pt.area * pt.factor;
             let g = &kin.grad;
-            for a in 0..8 {
+            for a in 0..POINT_DOFS {
                 let da = kin.dofs[a];
                 if da == NONE || (g[0][a] == 0.0 && g[1][a] == 0.0) {
                     continue;
                 }
                 let ra0 = g[0][a] * d[(0, 0)] + g[1][a] * d[(1, 0)];
                 let ra1 = g[0][a] * d[(0, 1)] + g[1][a] * d[(1, 1)];
-                for b in 0..8 {
+                for b in 0..POINT_DOFS {
                     let db = kin.dofs[b];
                     if db == NONE {
                         continue;

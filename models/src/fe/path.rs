@@ -670,7 +670,7 @@ fn shift_predictor(p: &FeProblem, cur: &[f64], trial: &mut [f64], x: f64, da: f6
     use super::mesh::NONE;
     let xs = &p.mesh.x;
     let nn = xs.len();
-    // Per node [u, w, θ, s]: the axial displacement only under small rotations (see above).
+    // Per node [u, w, θ]: the axial displacement only under small rotations (see above).
     let first = usize::from(p.large_rotation);
     for i in 0..nn {
         if (xs[i] - x).abs() > zone {
@@ -681,7 +681,7 @@ fn shift_predictor(p: &FeProblem, cur: &[f64], trial: &mut [f64], x: f64, da: f6
         let t = ((xt - xs[j]) / (xs[j + 1] - xs[j])).clamp(0.0, 1.0);
         for layer in 0..p.mesh.layers.len() {
             let (di, dj, dk) = (p.mesh.dofs(layer, i), p.mesh.dofs(layer, j), p.mesh.dofs(layer, j + 1));
-            for c in first..4 {
+            for c in first..3 {
                 if di[c] != NONE && dj[c] != NONE && dk[c] != NONE && di[c] != p.control {
                     trial[di[c]] = (1.0 - t) * cur[dj[c]] + t * cur[dk[c]];
                 }

@@ -40,7 +40,7 @@ use super::assembly::FeProblem;
 use super::beam;
 use super::crack::CrackMeasures;
 use super::energy::path_work;
-use super::interface::{self, PointKind};
+use super::interface::{self, PointKind, POINT_DOFS};
 use super::mesh::NONE;
 use super::pool::{self, Pooled};
 use super::run_types::{FrontTrack, PathSettings, RunStats, StepRow};
@@ -317,7 +317,7 @@ impl<const D: usize> Layout<D> {
             return Err(Unfit::Structure("the interface must run from beyond the loaded end to the far end"));
         }
         let mut chain = Vec::with_capacity(segs.len() + 1);
-        let mut hess = [[[0.0; 8]; 8]; 2];
+        let mut hess = [[[0.0; POINT_DOFS]; POINT_DOFS]; 2];
         let zero = vec![0.0; mesh.n_dofs()];
         for k in 0..=segs.len() {
             let pi = if k < segs.len() { segs[k].a } else { segs[k - 1].b };

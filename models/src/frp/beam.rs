@@ -527,7 +527,6 @@ impl FrpBeam {
             axial: true,
             first: 0,
             last: nn - 1,
-            surface: None,
         };
         let frp = Layer {
             section: Section { e: ef, g: PLATE_SHEAR_RATIO * ef, b: plate.width, h: tf },
@@ -535,7 +534,6 @@ impl FrpBeam {
             axial: true,
             first: 0,
             last: layout.plate_end,
-            surface: None,
         };
         let mesh = Mesh::new(x, vec![rc, frp], 0)?;
         let mut points = Vec::with_capacity(layout.plate_end + 1);

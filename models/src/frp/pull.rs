@@ -400,7 +400,6 @@ impl FrpPull {
             axial: false,
             first: 0,
             last: nn - 1,
-            surface: None,
         };
         let plate = Layer {
             section: Section { e: equivalent.plate_modulus, g: equivalent.plate_modulus, b: self.plate.width, h: tf },
@@ -408,7 +407,6 @@ impl FrpPull {
             axial: true,
             first: 0,
             last: nn - 1,
-            surface: None,
         };
         let mesh = Mesh::new(x, vec![concrete, plate], 0)?;
         let mut points = Vec::with_capacity(nn);

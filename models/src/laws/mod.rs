@@ -7,7 +7,9 @@
 //!   criterion ([`MixedModeCriterion`]);
 //! * [`Exponential`] (`exponential`): Xu–Needleman-type exponential law with secant unloading;
 //! * [`Bridging`] (`bridging`): matrix plus fibre-bridging superposition (R-curve), Dávila, Rose &
-//!   Camanho.
+//!   Camanho;
+//! * [`SeriesCompliance`] (`series_compliance`): any of them in series with a through-thickness
+//!   compliance (the adherends' give between their sections and the interface).
 //!
 //! All are secant-damage laws: unloading returns along the damaged secant to the origin, a
 //! closing gap meets the undamaged normal penalty, and the tangent returned while damage grows is
@@ -22,6 +24,7 @@ mod exponential;
 pub mod lu_bond_slip;
 mod response;
 mod root;
+mod series_compliance;
 mod st_czm;
 mod strength_model;
 pub mod verify;
@@ -30,5 +33,6 @@ pub use bilinear::{Bilinear, MixedModeCriterion};
 pub use bridging::Bridging;
 pub use exponential::Exponential;
 pub use lu_bond_slip::LuBondSlip;
+pub use series_compliance::SeriesCompliance;
 pub use st_czm::StCzm;
 pub use strength_model::{ModeStrength, StrengthShape};
