@@ -78,5 +78,9 @@ fn a_law_in_series_reads_and_writes_as_a_configuration_and_refuses_a_negative_co
     assert!(error.contains("normal_compliance") && error.contains("negative"), "{error}");
     let text = "type = \"series_compliance\"\nnormal_compliance = 1e-4\n[law]\ntype = \"bilinear\"\npenalty = 1e5\nstrength_n = -30.0\nstrength_t = 45.0\ng_ic = 0.28\ng_iic = 0.9\neta = 2.1";
     let error = law_from_toml(text).unwrap_err().to_string();
-    assert!(error.contains("strength_n"), "{error}");
+    assert!(error.contains("`law.strength_n`"), "{error}");
+    // A wrapped law built in code and never validated is named by its path in a configuration.
+    let broken = Bilinear { strength_n: -30.0, ..law };
+    let error = SeriesCompliance::new(Box::new(broken), 1e-4).unwrap_err().to_string();
+    assert!(error.contains("`law.strength_n`"), "{error}");
 }

@@ -102,7 +102,13 @@ impl CohesiveLaw for SeriesCompliance {
     fn validate(&self) -> Result<()> {
         let c = self.normal_compliance;
         czid_core::error::require_non_negative("law series_compliance", "normal_compliance", c)?;
-        self.law.validate()
+        // Name the wrapped law's field by its path in the configuration (`law.strength_n`).
+        self.law.validate().map_err(|e| match e {
+            CzError::InvalidParameter { name, value, reason, .. } => {
+                CzError::invalid("law series_compliance", format!("law.{name}"), value, reason)
+            }
+            other => other,
+        })
     }
 
     fn evaluate(&self, gap: &Gap, previous: &LawState) -> LawEval {
