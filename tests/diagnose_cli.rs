@@ -12,10 +12,23 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("czid-diagnose-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+/// A path `name` that does not exist yet, inside a scratch folder removed when the test ends.
+struct Scratch {
+    _folder: tempfile::TempDir,
+    path: PathBuf,
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = PathBuf;
+    fn deref(&self) -> &PathBuf {
+        &self.path
+    }
+}
+
+fn scratch(name: &str) -> Scratch {
+    let folder = tempfile::Builder::new().prefix("czid-diagnose-cli-").tempdir().unwrap();
+    let path = folder.path().join(name);
+    Scratch { _folder: folder, path }
 }
 
 #[test]
@@ -49,7 +62,7 @@ fn an_unknown_candidate_lists_the_known_ones() {
 #[test]
 fn a_result_file_without_the_parameters_is_explained() {
     let out = scratch("from");
-    std::fs::create_dir_all(&out).unwrap();
+    std::fs::create_dir_all(&*out).unwrap();
     let bad = out.join("result.json");
     std::fs::write(&bad, r#"{"parameters": {"law.strength_n": {"value": 30.0}}}"#).unwrap();
     let o = czid(&[

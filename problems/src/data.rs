@@ -511,17 +511,17 @@ mod tests {
         }
     }
 
-    fn write(name: &str, text: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("czid-data-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("t.csv"), text).unwrap();
+    /// A scratch folder holding `text` as `t.csv`, removed when the test ends.
+    fn write(name: &str, text: &str) -> tempfile::TempDir {
+        let dir = tempfile::Builder::new().prefix(&format!("czid-data-{name}-")).tempdir().unwrap();
+        std::fs::write(dir.path().join("t.csv"), text).unwrap();
         dir
     }
 
     #[test]
     fn reads_and_converts_crack_length_to_debonded_length() {
         let dir = write("ok", "Disp,Force,CrackExt\n0,0,40\n1,10,40\n2,15,42.5\n");
-        let e = spec("t.csv").load(&dir).unwrap();
+        let e = spec("t.csv").load(dir.path()).unwrap();
         assert_eq!(e.initial_crack, Some(40.0));
         assert_eq!(e.debonded_length.unwrap().y(), &[0.0, 0.0, 2.5]);
         assert_eq!(e.load.y(), &[0.0, 10.0, 15.0]);
@@ -533,7 +533,7 @@ mod tests {
         let mut s = spec("t.csv");
         s.length_unit = LengthUnit::Metre;
         s.force_unit = ForceUnit::KiloNewton;
-        let e = s.load(&dir).unwrap();
+        let e = s.load(dir.path()).unwrap();
         assert_eq!(e.load.x(), &[0.0, 1.0]);
         assert_eq!(e.load.y(), &[0.0, 10.0]);
     }
@@ -549,7 +549,7 @@ mod tests {
         ];
         for (name, text, expect) in cases {
             let dir = write(name, text);
-            let e = spec("t.csv").load(&dir).unwrap_err().to_string();
+            let e = spec("t.csv").load(dir.path()).unwrap_err().to_string();
             assert!(e.contains(expect), "{name}: {e}");
             assert!(e.contains("t.csv"), "{name} must name the file: {e}");
         }
@@ -562,7 +562,7 @@ mod tests {
         let dir = write("drop", "Disp,Force,CrackExt\n0,0,1\n2,1,1\n1,1,1\n3,2,1\n");
         let mut s = spec("t.csv");
         s.drop_non_increasing = true;
-        let e = s.load(&dir).unwrap();
+        let e = s.load(dir.path()).unwrap();
         assert_eq!(e.load.x(), &[0.0, 2.0, 3.0]);
         assert_eq!(e.dropped, DroppedRows { non_increasing: 1, ..Default::default() });
     }
@@ -572,17 +572,17 @@ mod tests {
         let text = "Disp,Force,CrackExt\n0,0,1\n1,NaN,1\n2,,1\n3,3,NaN\n4,4,1\n";
         let dir = write("nan-rows", text);
         // By default the first such row is an error that says how to drop them.
-        let e = spec("t.csv").load(&dir).unwrap_err().to_string();
+        let e = spec("t.csv").load(dir.path()).unwrap_err().to_string();
         assert!(e.contains("row 3") && e.contains("drop_non_finite"), "{e}");
         let mut s = spec("t.csv");
         s.drop_non_finite = true;
-        let e = s.load(&dir).unwrap();
+        let e = s.load(dir.path()).unwrap();
         assert_eq!(e.load.x(), &[0.0, 4.0]);
         assert_eq!(e.dropped, DroppedRows { non_finite: 3, ..Default::default() });
         assert_eq!(e.dropped.describe().unwrap(), "rows dropped: 3 with a missing or non-finite reading");
         // A text cell is still an error: it is not a gap in the record but a wrong column.
         let dir = write("text-row", "Disp,Force,CrackExt\n0,0,1\n1,abc,1\n2,2,1\n");
-        assert!(s.load(&dir).unwrap_err().to_string().contains("`abc` is not a number"));
+        assert!(s.load(dir.path()).unwrap_err().to_string().contains("`abc` is not a number"));
     }
 
     #[test]
@@ -594,7 +594,7 @@ mod tests {
         let dir = write("toe", text);
         let mut s = spec("t.csv");
         s.toe_compensation = Some([0.15, 0.9]);
-        let e = s.load(&dir).unwrap();
+        let e = s.load(dir.path()).unwrap();
         assert!((e.dropped.toe_zero - 0.5).abs() < 1e-12, "{:?}", e.dropped);
         // 0, 0.5 (1 N) and 0.8 (20 N) lie below 0.15 × 250 N.
         assert_eq!(e.dropped.toe, 3);
@@ -605,10 +605,10 @@ mod tests {
         assert!(said.contains("3 in the seating toe") && said.contains("moved by 0.5000 mm"), "{said}");
 
         s.toe_compensation = Some([0.5, 0.2]);
-        let err = s.load(&dir).unwrap_err().to_string();
+        let err = s.load(dir.path()).unwrap_err().to_string();
         assert!(err.contains("toe_compensation") && err.contains("0 < min < max < 1"), "{err}");
         s.toe_compensation = Some([0.97, 0.99]);
-        let err = s.load(&dir).unwrap_err().to_string();
+        let err = s.load(dir.path()).unwrap_err().to_string();
         assert!(err.contains("3 are needed") && err.contains("t.csv"), "{err}");
     }
 

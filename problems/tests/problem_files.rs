@@ -7,7 +7,7 @@ use czid_core::{
 };
 use czid_problems::problem_file::LoadedProblem;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A linear spring that never damages.
 #[derive(Debug, Serialize, Deserialize)]
@@ -114,9 +114,9 @@ budget = 100
 }
 
 /// Data made by hand: P = 2 mm² × 80 MPa/mm × d, so the answer is stiffness = 80.
-fn setup_dir(name: &str, problem: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("czid-pf-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// (A scratch folder removed when the test ends.)
+fn setup_dir(name: &str, problem: &str) -> Scratch {
+    let dir = Scratch(tempfile::Builder::new().prefix(&format!("czid-pf-{name}-")).tempdir().unwrap());
     let mut csv = String::from("d,P,L\n");
     for i in 0..=10 {
         let d = i as f64 / 10.0;
@@ -125,6 +125,16 @@ fn setup_dir(name: &str, problem: &str) -> PathBuf {
     std::fs::write(dir.join("patch.csv"), csv).unwrap();
     std::fs::write(dir.join("problem.toml"), problem).unwrap();
     dir
+}
+
+/// A scratch folder that reads as its path and is removed when it goes out of scope.
+struct Scratch(tempfile::TempDir);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        self.0.path()
+    }
 }
 
 fn read(dir: &Path) -> czid_core::Result<LoadedProblem> {
@@ -547,8 +557,7 @@ fn a_moment_curve_is_compared_with_the_midspan_moment_column() {
 
 #[test]
 fn truth_files_read_events_with_noise_and_rounding() {
-    let dir = std::env::temp_dir().join(format!("czid-pf-{}-truth-events", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch(tempfile::Builder::new().prefix("czid-pf-truth-events-").tempdir().unwrap());
     let truth = "[law]\ntype = \"toy_spring\"\nstiffness = 50.0\n[model]\ntype = \"toy_patch\"\narea = 2.0\n\
                  max_opening = 1.0\n[noise]\npoints = 10\nmax_displacement = 0.8\n\
                  [[event]]\nkind = \"peak_load\"\nresolution = 30.0\n\
