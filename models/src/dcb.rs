@@ -294,6 +294,14 @@ impl Dcb {
         Ok((p, scale))
     }
 
+    /// Checks `law` and the root compliance it meets, and returns the law in series with that
+    /// compliance when there is one ([`Effects::interface_law`]).
+    fn interface_law(&self, law: &dyn CohesiveLaw) -> Result<Option<crate::laws::SeriesCompliance>> {
+        law.validate()?;
+        self.effects.check_root_compliance("dcb", law)?;
+        self.effects.interface_law(law)
+    }
+
     fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
         // The debonded length is the visible crack (what a camera sees).
         self.control
@@ -357,9 +365,7 @@ impl ForwardModel for Dcb {
 
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
         let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
-        law.validate().map_err(fail)?;
-        self.effects.check_root_compliance("dcb", law).map_err(fail)?;
-        let series = self.effects.interface_law(law).map_err(fail)?;
+        let series = self.interface_law(law).map_err(fail)?;
         let law = series.as_ref().map_or(law, |s| s as &dyn CohesiveLaw);
         let (p, scale) = self.problem().map_err(fail)?;
         let path = self.path(law, &scale);
@@ -379,9 +385,7 @@ pub fn simulate_with_stats(dcb: &Dcb, law: &dyn CohesiveLaw) -> Result<(Record, 
 /// [`simulate_with_stats`] with the engine's run options `run` instead of the model's
 /// ([`RUN_OPTIONS`]), e.g. to check one of its shortcuts against the run without it.
 pub fn simulate_with_options(dcb: &Dcb, law: &dyn CohesiveLaw, run: &fe::RunOptions) -> Result<(Record, fe::RunStats)> {
-    law.validate()?;
-    dcb.effects.check_root_compliance("dcb", law)?;
-    let series = dcb.effects.interface_law(law)?;
+    let series = dcb.interface_law(law)?;
     let law = series.as_ref().map_or(law, |s| s as &dyn CohesiveLaw);
     let (p, scale) = dcb.problem()?;
     let path = dcb.path(law, &scale);
