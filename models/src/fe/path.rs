@@ -31,7 +31,7 @@ use czid_core::{CohesiveLaw, CzError, LawState};
 use super::assembly::{FeProblem, InterfaceRule};
 use super::crack::{self, CrackMeasures};
 use super::energy::{self, Ledger};
-use super::interface::PointKind;
+use super::interface::{PointKind, SIDE};
 use super::newton::{Newton, StepFailure};
 use super::run_types::{FrontTrack, PathFailure, PathSettings, RunOptions, RunStats, StepRow};
 
@@ -681,7 +681,7 @@ fn shift_predictor(p: &FeProblem, cur: &[f64], trial: &mut [f64], x: f64, da: f6
         let t = ((xt - xs[j]) / (xs[j + 1] - xs[j])).clamp(0.0, 1.0);
         for layer in 0..p.mesh.layers.len() {
             let (di, dj, dk) = (p.mesh.dofs(layer, i), p.mesh.dofs(layer, j), p.mesh.dofs(layer, j + 1));
-            for c in first..3 {
+            for c in first..SIDE {
                 if di[c] != NONE && dj[c] != NONE && dk[c] != NONE && di[c] != p.control {
                     trial[di[c]] = (1.0 - t) * cur[dj[c]] + t * cur[dk[c]];
                 }
