@@ -90,10 +90,16 @@ const OWNER: &str = "model dcb";
 
 /// The engine's choices for DCB runs: segment integration of the interface (smooth crack growth,
 /// see [`crate::fe::segment`]), records on the output grid, the window around the crack front,
-/// and under large rotations the whole mesh cut far ahead of the front.
+/// and under large rotations the whole mesh cut far ahead of the front and its free arm behind
+/// the front merged into elements as long as the pre-crack arm's.
 pub const RUN_OPTIONS: fe::RunOptions = RUN;
-const RUN: fe::RunOptions =
-    fe::RunOptions { interface: fe::InterfaceRule::Segments, outputs_only: true, window: true, cut_far_field: true };
+const RUN: fe::RunOptions = fe::RunOptions {
+    interface: fe::InterfaceRule::Segments,
+    outputs_only: true,
+    window: true,
+    cut_far_field: true,
+    coarsen_free_arm: true,
+};
 
 impl Dcb {
     /// The DCB of Shi & Zhang (l = 180, b = 20, a0 = 50, 2h = 3.24 mm; E11 = 130, E22 = 6.5,

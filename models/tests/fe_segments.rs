@@ -206,7 +206,13 @@ fn windowed_solution_equals_the_whole_mesh_solution() {
         let mut path = paper_path(arm_deflection, 30);
         path.crack_origin = d.a0;
         let run = |window: bool| {
-            let o = RunOptions { interface: InterfaceRule::Segments, outputs_only: true, window, cut_far_field: false };
+            let o = RunOptions {
+                interface: InterfaceRule::Segments,
+                outputs_only: true,
+                window,
+                cut_far_field: false,
+                coarsen_free_arm: false,
+            };
             fe::run_with(&p, law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error))
         };
         let ((whole, sw), (win, sv)) = (run(false), run(true));
@@ -273,7 +279,13 @@ fn debonded_length_follows_the_damage_threshold() {
         let mut path = paper_path(2.0, 20);
         path.crack_origin = d.a0;
         path.damage_threshold = threshold;
-        let o = RunOptions { interface: InterfaceRule::Segments, outputs_only: true, window, cut_far_field: false };
+        let o = RunOptions {
+            interface: InterfaceRule::Segments,
+            outputs_only: true,
+            window,
+            cut_far_field: false,
+            coarsen_free_arm: false,
+        };
         fe::run_with(&p, &law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error)).0
     };
     let (full, half, half_whole) = (run(1.0 - 1e-9, true), run(0.5, true), run(0.5, false));

@@ -45,6 +45,13 @@ impl Ledger {
         }
     }
 
+    /// Keeps the committed tractions and gaps of the points `point_of` (old indices, in their new
+    /// order) after the problem lost the others; the totals keep the work done on every point.
+    pub(crate) fn keep_points(&mut self, point_of: &[usize]) {
+        self.tractions = point_of.iter().map(|&i| self.tractions[i]).collect();
+        self.gaps = point_of.iter().map(|&i| self.gaps[i]).collect();
+    }
+
     /// Adds the work of a converged step.
     pub fn commit(
         &mut self,

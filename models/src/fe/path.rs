@@ -26,6 +26,8 @@
 //!   run the window gives up on, by the whole-mesh solver here.
 //! * A run that still fails returns the error and every row that converged.
 
+use std::rc::Rc;
+
 use czid_core::{CohesiveLaw, CzError, LawState};
 
 use super::assembly::{FeProblem, InterfaceRule};
@@ -153,10 +155,28 @@ impl Control {
     }
 }
 
+/// The problem a whole-mesh run solves: the one it was given, or that one with its free arm
+/// coarsened (`fe::coarsen`).
+#[derive(Clone)]
+enum Problem<'a> {
+    Given(&'a FeProblem),
+    Coarsened(Rc<FeProblem>),
+}
+
+impl std::ops::Deref for Problem<'_> {
+    type Target = FeProblem;
+    fn deref(&self) -> &FeProblem {
+        match self {
+            Problem::Given(p) => p,
+            Problem::Coarsened(p) => p,
+        }
+    }
+}
+
 /// The whole-mesh solver's state: the problem, Newton, the committed solution and what has been
 /// recorded of it.
 struct WholeMesh<'a> {
-    p: &'a FeProblem,
+    p: Problem<'a>,
     law: &'a dyn CohesiveLaw,
     s: &'a PathSettings,
     o: &'a RunOptions,
@@ -274,6 +294,21 @@ struct Measures {
     scratch: Vec<f64>,
 }
 
+impl Measures {
+    fn of(p: &FeProblem) -> Self {
+        let np = p.points.len();
+        let cohesive: Vec<usize> = (0..np).filter(|&i| p.points[i].kind == PointKind::Cohesive).collect();
+        let xs: Vec<f64> = cohesive.iter().map(|&i| p.mesh.x[p.points[i].node]).collect();
+        Measures {
+            dmg: vec![0.0; cohesive.len()],
+            point_stored: vec![0.0; np],
+            scratch: vec![0.0; cohesive.len()],
+            cohesive,
+            xs,
+        }
+    }
+}
+
 impl<'a> WholeMesh<'a> {
     fn new(
         p: &'a FeProblem,
@@ -294,18 +329,10 @@ impl<'a> WholeMesh<'a> {
         let mode_one = if segments { super::segment::ModeOne::of(law) } else { None };
         let n = nw.asm.n();
         let np = p.points.len();
-        let cohesive: Vec<usize> = (0..np).filter(|&i| p.points[i].kind == PointKind::Cohesive).collect();
-        let xs: Vec<f64> = cohesive.iter().map(|&i| p.mesh.x[p.points[i].node]).collect();
-        let measures = Measures {
-            dmg: vec![0.0; cohesive.len()],
-            point_stored: vec![0.0; np],
-            scratch: vec![0.0; cohesive.len()],
-            cohesive,
-            xs,
-        };
+        let measures = Measures::of(p);
         let init = law.initial_state();
         WholeMesh {
-            p,
+            p: Problem::Given(p),
             law,
             s,
             o,
@@ -400,7 +427,8 @@ impl<'a> WholeMesh<'a> {
     /// shorter step or the switch to dissipation control.
     fn displacement_step(&mut self, c: &mut Control) -> Result<(), PathFailure> {
         self.place_cut();
-        let (p, law, s, ic) = (self.p, self.law, self.s, self.p.control);
+        let (p, law, s, ic) = (self.p.clone(), self.law, self.s, self.p.control);
+        let p = &*p;
         while c.k_out < s.outputs && c.spacing * c.k_out as f64 <= c.pos + c.eps {
             c.k_out += 1;
         }
@@ -464,7 +492,8 @@ impl<'a> WholeMesh<'a> {
     /// even with tiny increments, a jump over the unstable stretch.
     fn dissipation_step(&mut self, c: &mut Control) -> Result<(), PathFailure> {
         self.place_cut();
-        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let (p, law, ic) = (self.p.clone(), self.law, self.p.control);
+        let p = &*p;
         let c0 = self.cur.q[ic];
         let l0 = self.cur.reaction;
         // Do not jump past the target: the run must end exactly on it.
@@ -542,7 +571,8 @@ impl<'a> WholeMesh<'a> {
     /// under displacement control (the states recorded are still equilibria; the skipped part is
     /// not).
     fn jump_over(&mut self, c: &mut Control) -> Result<(), PathFailure> {
-        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let (p, law, ic) = (self.p.clone(), self.law, self.p.control);
+        let p = &*p;
         for k in 1..=4 {
             // (may end beyond the target when it lies inside the unstable stretch)
             let dh = 0.5 * c.spacing * k as f64;
@@ -571,7 +601,8 @@ impl<'a> WholeMesh<'a> {
     /// stores) and stored, point by point. The committed state is not touched, so a trial can be
     /// weighed before it is accepted.
     fn ledger_to_trial(&self, ledger: &mut Ledger, reaction: f64) -> (f64, f64) {
-        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let (p, law, ic) = (self.p.clone(), self.law, self.p.control);
+        let p = &*p;
         let (t, g) = (&self.nw.asm.trial, &self.nw.asm.gaps);
         let (dc, r_old) = (self.trial[ic] - self.cur.q[ic], self.cur.reaction);
         if self.segments {
@@ -593,7 +624,8 @@ impl<'a> WholeMesh<'a> {
 
     /// [`WholeMesh::commit`] with the ledger already brought to the trial solution.
     fn accept(&mut self, reaction: f64, record: bool, ledger: Ledger, (dissipated, stored): (f64, f64)) {
-        let (p, law, ic) = (self.p, self.law, self.p.control);
+        let (p, law, ic) = (self.p.clone(), self.law, self.p.control);
+        let p = &*p;
         self.follow_cut();
         self.ledger = ledger;
         self.prev_q.copy_from_slice(&self.cur.q);
@@ -637,6 +669,43 @@ impl<'a> WholeMesh<'a> {
                 shear_work: Some(self.ledger.shear_work),
             });
         }
+        self.coarsen_free_arm();
+    }
+
+    /// Under large rotations, thins the free arm behind the crack front once enough of it has
+    /// failed (`fe::coarsen`), carrying the committed state over to the coarser problem.
+    fn coarsen_free_arm(&mut self) {
+        if !(self.o.coarsen_free_arm && self.p.large_rotation && self.segments) {
+            return;
+        }
+        let Some(c) = super::coarsen::free_arm(&self.p, &self.cur.states, &self.nw.asm.trial, &self.nw.asm.gaps) else {
+            return;
+        };
+        let by_dof = |v: &[f64]| -> Vec<f64> { c.dof_of.iter().map(|&d| v[d]).collect() };
+        self.cur.q = by_dof(&self.cur.q);
+        self.prev_q = by_dof(&self.prev_q);
+        self.trial = by_dof(&self.trial);
+        self.cur.states = c.point_of.iter().map(|&i| self.cur.states[i]).collect();
+        self.ledger.keep_points(&c.point_of);
+        let node_before = c.node_of;
+        let p = Rc::new(c.problem);
+        let (counters, safeguard) = (self.nw.counters, self.nw.safeguard);
+        self.nw = Newton::with_rule(&p, self.law, self.s.newton, self.o.interface);
+        self.nw.counters = counters;
+        self.nw.safeguard = safeguard;
+        self.measures = Measures::of(&p);
+        if let Some(old) = self.cut.take() {
+            // The same cut on the new numbering (it only moves on).
+            self.cut = Cut::of(&p, self.law, self.segments).map(|mut cut| {
+                cut.reached_end = old.reached_end;
+                cut.from_node = match old.from_node {
+                    usize::MAX => usize::MAX,
+                    f => node_before.partition_point(|&j| j < f),
+                };
+                cut
+            });
+        }
+        self.p = Problem::Coarsened(p);
     }
 
     /// Debonded length, process zone and tip of the committed state: from the segments' fronts
