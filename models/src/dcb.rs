@@ -98,7 +98,7 @@ const RUN: fe::RunOptions = fe::RunOptions {
     outputs_only: true,
     window: true,
     cut_far_field: true,
-    coarsen_free_arm: true,
+    fine_zone: true,
 };
 
 impl Dcb {

@@ -62,7 +62,7 @@ const RUN: fe::RunOptions = fe::RunOptions {
     outputs_only: true,
     window: false,
     cut_far_field: false,
-    coarsen_free_arm: false,
+    fine_zone: false,
 };
 
 impl Enf {

@@ -81,7 +81,7 @@ const RUN: fe::RunOptions = fe::RunOptions {
     outputs_only: true,
     window: false,
     cut_far_field: false,
-    coarsen_free_arm: false,
+    fine_zone: false,
 };
 
 /// Stiffness of the lever's ties relative to the specimen's beam-theory stiffness: their

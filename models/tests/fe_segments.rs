@@ -211,7 +211,7 @@ fn windowed_solution_equals_the_whole_mesh_solution() {
                 outputs_only: true,
                 window,
                 cut_far_field: false,
-                coarsen_free_arm: false,
+                fine_zone: false,
             };
             fe::run_with(&p, law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error))
         };
@@ -284,7 +284,7 @@ fn debonded_length_follows_the_damage_threshold() {
             outputs_only: true,
             window,
             cut_far_field: false,
-            coarsen_free_arm: false,
+            fine_zone: false,
         };
         fe::run_with(&p, &law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error)).0
     };

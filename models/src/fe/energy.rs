@@ -45,11 +45,21 @@ impl Ledger {
         }
     }
 
-    /// Keeps the committed tractions and gaps of the points `point_of` (old indices, in their new
-    /// order) after the problem lost the others; the totals keep the work done on every point.
-    pub(crate) fn keep_points(&mut self, point_of: &[usize]) {
-        self.tractions = point_of.iter().map(|&i| self.tractions[i]).collect();
-        self.gaps = point_of.iter().map(|&i| self.gaps[i]).collect();
+    /// The committed tractions and gaps after the problem's points changed: `point_of[i]` is the
+    /// old point the new point `i` was, or `None` for a point that `fresh(i)` gives. The totals keep
+    /// the work done on every point, the removed ones included.
+    pub(crate) fn remap_points(&mut self, point_of: &[Option<usize>], mut fresh: impl FnMut(usize) -> (Traction, Gap)) {
+        let (mut tractions, mut gaps) = (Vec::with_capacity(point_of.len()), Vec::with_capacity(point_of.len()));
+        for (i, o) in point_of.iter().enumerate() {
+            let (t, g) = match o {
+                Some(o) => (self.tractions[*o], self.gaps[*o]),
+                None => fresh(i),
+            };
+            tractions.push(t);
+            gaps.push(g);
+        }
+        self.tractions = tractions;
+        self.gaps = gaps;
     }
 
     /// Adds the work of a converged step.

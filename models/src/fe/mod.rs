@@ -11,8 +11,8 @@
 //! * [`symmetric_band`]: its `L D Lᵀ` counterpart for symmetric iteration matrices;
 //! * [`newton`]: Newton–Raphson under displacement or dissipation control;
 //! * [`path`]: path following (adaptive steps, output grid, snap-back detours);
-//! * `coarsen`: under large rotations, the free arm behind a crack front merged into longer
-//!   elements as the crack grows (used by [`path::run_with`]);
+//! * `fine_zone`: under large rotations, a beam mesh fine only around the crack front, moving with
+//!   it (used by [`path::run_with`]);
 //! * [`run_types`]: what a run is asked and returns (settings, rows, statistics), shared by `path` and `window`;
 //! * `pool`: work arrays reused across the runs of a thread;
 //! * `window`: the solution restricted to the nodes around a crack front, the linear regions
@@ -33,11 +33,11 @@
 pub mod assembly;
 pub mod banded;
 pub mod beam;
-pub(crate) mod coarsen;
 pub mod corotational;
 pub mod crack;
 pub mod energy;
 pub mod fibre;
+pub(crate) mod fine_zone;
 pub mod interface;
 pub mod mesh;
 pub mod newton;

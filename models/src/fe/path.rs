@@ -28,11 +28,12 @@
 
 use std::rc::Rc;
 
-use czid_core::{CohesiveLaw, CzError, LawState};
+use czid_core::{CohesiveLaw, CzError, Gap, LawEval, LawState, Traction};
 
 use super::assembly::{FeProblem, InterfaceRule};
 use super::crack::{self, CrackMeasures};
 use super::energy::{self, Ledger};
+use super::fine_zone::FineZone;
 use super::interface::{PointKind, SIDE};
 use super::newton::{Newton, StepFailure};
 use super::run_types::{FrontTrack, PathFailure, PathSettings, RunOptions, RunStats, StepRow};
@@ -155,8 +156,8 @@ impl Control {
     }
 }
 
-/// The problem a whole-mesh run solves: the one it was given, or that one with its free arm
-/// coarsened (`fe::coarsen`).
+/// The problem a whole-mesh run solves: the one it was given, or that one coarse away from the
+/// crack front (`fe::fine_zone`).
 #[derive(Clone)]
 enum Problem<'a> {
     Given(&'a FeProblem),
@@ -176,7 +177,11 @@ impl std::ops::Deref for Problem<'_> {
 /// The whole-mesh solver's state: the problem, Newton, the committed solution and what has been
 /// recorded of it.
 struct WholeMesh<'a> {
+    /// The problem the run was given, and the one it solves (with a fine zone, a part of it).
+    base: &'a FeProblem,
     p: Problem<'a>,
+    /// Under large rotations, the zone around the crack front where the mesh is fine.
+    zone: Option<FineZone>,
     law: &'a dyn CohesiveLaw,
     s: &'a PathSettings,
     o: &'a RunOptions,
@@ -311,17 +316,26 @@ impl Measures {
 
 impl<'a> WholeMesh<'a> {
     fn new(
-        p: &'a FeProblem,
+        base: &'a FeProblem,
         law: &'a dyn CohesiveLaw,
         s: &'a PathSettings,
         o: &'a RunOptions,
         fallback: Option<&'static str>,
     ) -> Self {
+        let segments = o.interface == InterfaceRule::Segments;
+        let (problem, zone) = match o.fine_zone && segments {
+            true => match FineZone::of(base, law, s.crack_origin) {
+                Some((zone, p)) => (Problem::Coarsened(Rc::new(p)), Some(zone)),
+                None => (Problem::Given(base), None),
+            },
+            false => (Problem::Given(base), None),
+        };
+        let p = problem.clone();
+        let p = &*p;
         let mut nw = Newton::with_rule(p, law, s.newton, o.interface);
         // With segments, forces are continuous and a good predictor leaves Newton in its basin: the
         // branch-cycling safeguard of the nodal rule only slows it down.
         nw.safeguard = o.interface == InterfaceRule::Nodal;
-        let segments = o.interface == InterfaceRule::Segments;
         // Steps double after convergence in at most this many iterations. With segments a crack front
         // crossing many points per step is normal work for Newton (typically 4-5 quadratically
         // converging iterations), not a sign that the step is too long.
@@ -332,7 +346,9 @@ impl<'a> WholeMesh<'a> {
         let measures = Measures::of(p);
         let init = law.initial_state();
         WholeMesh {
-            p: Problem::Given(p),
+            base,
+            p: problem,
+            zone,
             law,
             s,
             o,
@@ -669,43 +685,68 @@ impl<'a> WholeMesh<'a> {
                 shear_work: Some(self.ledger.shear_work),
             });
         }
-        self.coarsen_free_arm();
+        self.follow_front();
     }
 
-    /// Under large rotations, thins the free arm behind the crack front once enough of it has
-    /// failed (`fe::coarsen`), carrying the committed state over to the coarser problem.
-    fn coarsen_free_arm(&mut self) {
-        if !(self.o.coarsen_free_arm && self.p.large_rotation && self.segments) {
-            return;
-        }
-        let Some(c) = super::coarsen::free_arm(&self.p, &self.cur.states, &self.nw.asm.trial, &self.nw.asm.gaps) else {
-            return;
-        };
-        let by_dof = |v: &[f64]| -> Vec<f64> { c.dof_of.iter().map(|&d| v[d]).collect() };
-        self.cur.q = by_dof(&self.cur.q);
-        self.prev_q = by_dof(&self.prev_q);
-        self.trial = by_dof(&self.trial);
-        self.cur.states = c.point_of.iter().map(|&i| self.cur.states[i]).collect();
-        self.ledger.keep_points(&c.point_of);
-        let node_before = c.node_of;
-        let p = Rc::new(c.problem);
+    /// Under large rotations, moves the fine zone with the crack front when it has moved far
+    /// enough (`fe::fine_zone`), carrying the committed state over to the new problem.
+    fn follow_front(&mut self) {
+        let Some(zone) = self.zone.as_mut() else { return };
+        let onset = if self.front.x.is_finite() { self.front.x } else { self.s.crack_origin };
+        let (states, evals, gaps) = (&self.cur.states, &self.nw.asm.trial, &self.nw.asm.gaps);
+        let Some(m) = zone.follow(self.base, &self.p, states, evals, gaps, onset) else { return };
+        let (kept, base_x) = (&zone.kept, &self.base.mesh.x);
+        self.cur.q = m.carry(kept, base_x, &self.cur.q);
+        self.prev_q = m.carry(kept, base_x, &self.prev_q);
+        self.trial = m.carry(kept, base_x, &self.trial);
+        // Inserted points: the law's state at their gap, reached from the virgin state (ahead of
+        // the front they have been loaded monotonically).
+        let p = &m.problem;
+        let law = self.law;
+        let mut hess = [[[0.0; super::interface::POINT_DOFS]; super::interface::POINT_DOFS]; 2];
+        let fresh: Vec<Option<(LawEval, Gap)>> = m
+            .point_of
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                o.is_none().then(|| {
+                    let k = super::interface::kinematics(&p.mesh, &p.points[i], &self.cur.q, true, &mut hess);
+                    let g = Gap::new(k.gap[0], k.gap[1]);
+                    (law.evaluate(&g, &law.initial_state()), g)
+                })
+            })
+            .collect();
+        let old_states = std::mem::take(&mut self.cur.states);
+        self.cur.states = m
+            .point_of
+            .iter()
+            .zip(&fresh)
+            .map(|(o, f)| match (o, f) {
+                (Some(o), _) => old_states[*o],
+                (None, Some((ev, _))) => ev.state,
+                (None, None) => law.initial_state(),
+            })
+            .collect();
+        self.ledger.remap_points(&m.point_of, |i| {
+            fresh[i].map_or((Traction::zeros(), Gap::zeros()), |(ev, g)| (ev.traction, g))
+        });
         let (counters, safeguard) = (self.nw.counters, self.nw.safeguard);
-        self.nw = Newton::with_rule(&p, self.law, self.s.newton, self.o.interface);
+        self.nw = Newton::with_rule(p, law, self.s.newton, self.o.interface);
         self.nw.counters = counters;
         self.nw.safeguard = safeguard;
-        self.measures = Measures::of(&p);
+        self.measures = Measures::of(p);
         if let Some(old) = self.cut.take() {
             // The same cut on the new numbering (it only moves on).
-            self.cut = Cut::of(&p, self.law, self.segments).map(|mut cut| {
+            self.cut = Cut::of(p, law, self.segments).map(|mut cut| {
                 cut.reached_end = old.reached_end;
                 cut.from_node = match old.from_node {
                     usize::MAX => usize::MAX,
-                    f => node_before.partition_point(|&j| j < f),
+                    f => m.node(&zone.kept, f),
                 };
                 cut
             });
         }
-        self.p = Problem::Coarsened(p);
+        self.p = Problem::Coarsened(Rc::new(m.problem));
     }
 
     /// Debonded length, process zone and tip of the committed state: from the segments' fronts

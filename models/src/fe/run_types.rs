@@ -145,11 +145,11 @@ pub struct RunOptions {
     /// whole-mesh solve (`fe::path`'s cut: 25 decay lengths of the arm on its interface ahead of
     /// the front, where the deflection has fallen to e⁻²⁵ of its value there).
     pub cut_far_field: bool,
-    /// Under large rotations, merge the beam elements of the free arm behind the crack front into
-    /// elements as long as the mesh's longest (a DCB's pre-crack arm) as the crack grows
-    /// (`fe::coarsen`: where the interface has failed and is open, from five such elements behind
-    /// the first point that still carries something).
-    pub coarsen_free_arm: bool,
+    /// Under large rotations, keep the beam mesh fine only in a zone around the crack front that
+    /// moves with it (`fe::fine_zone`): the free arm behind it in elements as long as the mesh's
+    /// longest (a DCB's pre-crack arm), the intact part ahead in elements of half the arm's decay
+    /// length on its interface, refined as the front approaches.
+    pub fine_zone: bool,
 }
 
 /// Largest share of the linear prediction of a front's advance that the parabola's curvature may
