@@ -5,7 +5,7 @@
 //! unknowns and a law in series.
 
 use czid_core::{columns, CohesiveLaw, Record};
-use czid_models::dcb::{self, Dcb};
+use czid_models::dcb::{self, Dcb, Symmetry};
 use czid_models::laws::{Bilinear, Bridging, StCzm};
 
 const FINE: czid_models::fe::RunOptions = czid_models::fe::RunOptions { fine_zone: false, ..dcb::RUN_OPTIONS };
@@ -49,6 +49,13 @@ fn the_papers_dcb_with_its_steep_law() {
     d.control.max_displacement = Some(10.0);
     let law = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap();
     compare("paper DCB, Table 3", &d, &law);
+}
+
+#[test]
+fn both_arms_meshed() {
+    let mut d = hartlen();
+    d.symmetry = Symmetry::Full;
+    compare("DCB-01, both arms", &d, &Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap());
 }
 
 #[test]
