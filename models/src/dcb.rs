@@ -93,13 +93,8 @@ const OWNER: &str = "model dcb";
 /// and under large rotations the whole mesh cut far ahead of the front and its free arm behind
 /// the front merged into elements as long as the pre-crack arm's.
 pub const RUN_OPTIONS: fe::RunOptions = RUN;
-const RUN: fe::RunOptions = fe::RunOptions {
-    interface: fe::InterfaceRule::Segments,
-    outputs_only: true,
-    window: true,
-    cut_far_field: true,
-    fine_zone: true,
-};
+const RUN: fe::RunOptions =
+    fe::RunOptions { window: true, cut_far_field: true, fine_zone: true, ..fe::RunOptions::segments() };
 
 impl Dcb {
     /// The DCB of Shi & Zhang (l = 180, b = 20, a0 = 50, 2h = 3.24 mm; E11 = 130, E22 = 6.5,

@@ -57,13 +57,7 @@ const OWNER: &str = "model enf";
 /// The engine's choices for ENF runs: segment integration of the interface and records on the
 /// output grid (and along snap-backs); the whole mesh is solved (the contact on the cracked faces
 /// is not linear, so the window does not apply).
-const RUN: fe::RunOptions = fe::RunOptions {
-    interface: fe::InterfaceRule::Segments,
-    outputs_only: true,
-    window: false,
-    cut_far_field: false,
-    fine_zone: false,
-};
+const RUN: fe::RunOptions = fe::RunOptions::segments();
 
 impl Enf {
     /// Hartlen's ENF-03 specimen (h = 2.7 mm per arm, b = 25, L = 50, a0 = 34.7 mm; E_L = 19.3,

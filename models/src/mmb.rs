@@ -76,13 +76,7 @@ pub type EngineRun = std::result::Result<(Vec<StepRow>, fe::RunStats), fe::PathF
 
 /// Whole-mesh solve with segment integration, records on the output grid (the window does not
 /// apply: the specimen is supported and loaded away from its cracked end, and has contact).
-const RUN: fe::RunOptions = fe::RunOptions {
-    interface: fe::InterfaceRule::Segments,
-    outputs_only: true,
-    window: false,
-    cut_far_field: false,
-    fine_zone: false,
-};
+const RUN: fe::RunOptions = fe::RunOptions::segments();
 
 /// Stiffness of the lever's ties relative to the specimen's beam-theory stiffness: their
 /// compliance, removed exactly from the record, is then about 1 % of the specimen's, and the

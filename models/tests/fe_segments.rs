@@ -8,7 +8,7 @@ mod fe_support;
 use czid_core::{CohesiveLaw, Gap, LawState};
 use czid_models::dcb::Dcb;
 use czid_models::fe::segment::{integrate, End, ModeOne, Segment};
-use czid_models::fe::{self, InterfaceRule, PathSettings, RunOptions};
+use czid_models::fe::{self, PathSettings, RunOptions};
 use czid_models::laws::{Bilinear, StCzm};
 use fe_support::TestBilinear;
 
@@ -206,13 +206,7 @@ fn windowed_solution_equals_the_whole_mesh_solution() {
         let mut path = paper_path(arm_deflection, 30);
         path.crack_origin = d.a0;
         let run = |window: bool| {
-            let o = RunOptions {
-                interface: InterfaceRule::Segments,
-                outputs_only: true,
-                window,
-                cut_far_field: false,
-                fine_zone: false,
-            };
+            let o = RunOptions { window, ..RunOptions::segments() };
             fe::run_with(&p, law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error))
         };
         let ((whole, sw), (win, sv)) = (run(false), run(true));
@@ -279,13 +273,7 @@ fn debonded_length_follows_the_damage_threshold() {
         let mut path = paper_path(2.0, 20);
         path.crack_origin = d.a0;
         path.damage_threshold = threshold;
-        let o = RunOptions {
-            interface: InterfaceRule::Segments,
-            outputs_only: true,
-            window,
-            cut_far_field: false,
-            fine_zone: false,
-        };
+        let o = RunOptions { window, ..RunOptions::segments() };
         fe::run_with(&p, &law, &path, &o).unwrap_or_else(|f| panic!("{}", f.error)).0
     };
     let (full, half, half_whole) = (run(1.0 - 1e-9, true), run(0.5, true), run(0.5, false));

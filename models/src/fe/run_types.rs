@@ -152,6 +152,20 @@ pub struct RunOptions {
     pub fine_zone: bool,
 }
 
+impl RunOptions {
+    /// Segment integration and records on the output grid, on the whole mesh, nothing left out or
+    /// coarsened: the base that models change a field or two of.
+    pub const fn segments() -> Self {
+        RunOptions {
+            interface: InterfaceRule::Segments,
+            outputs_only: true,
+            window: false,
+            cut_far_field: false,
+            fine_zone: false,
+        }
+    }
+}
+
 /// Largest share of the linear prediction of a front's advance that the parabola's curvature may
 /// add or remove before the prediction falls back to the line ([`FrontTrack::advance`]).
 const QUADRATIC_SHARE: f64 = 0.1;
