@@ -161,7 +161,8 @@ enum Command {
 #[derive(Args)]
 struct SetArgs {
     /// Replace a value of the problem file, e.g. `--set law.strength_n=20` or
-    /// `--set models.dcb.effects.large_rotation=true` (repeatable).
+    /// `--set models.dcb.effects.large_rotation=true` (`model.…` in a file with one top-level
+    /// [model]; repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE", value_parser = parse_set)]
     sets: Vec<(String, String)>,
 }
@@ -334,9 +335,9 @@ fn read_problem(problem: &Path, sets: &[(String, String)]) -> Result<LoadedProbl
 }
 
 fn run_simulate(problem: &Path, sets: &[(String, String)], out: &OutArgs) -> Result<(), CzError> {
-    if sets.is_empty() && is_model_file(problem) {
+    if is_model_file(problem) {
         // A model file (`[law]` and `[model]`, no test data): the forward run alone.
-        let file = TruthFile::read(problem)?;
+        let file = TruthFile::read_with(problem, sets)?;
         let dir = OutputDir::create(&out.out, out.force, false)?;
         let record = czid_problems::identify::simulate_model(&file, &dir)?;
         println!("{} steps; curves and plot written to {}", record.rows(), dir.path().display());

@@ -221,8 +221,8 @@ impl LoadedProblem {
 
     /// Reads a problem file with some values replaced, e.g. `("law.strength_n", "20")` or
     /// `("models.dcb.effects.large_rotation", "true")`: paths as in `[[parameter]]` (`law.*`,
-    /// `models.<experiment>.*`), plus `objective.*`, `optimizer.*` and `optimizers.<label>.*`. Values are TOML
-    /// (numbers, booleans, quoted strings).
+    /// `models.<experiment>.*`), plus `model.*` (a file with one top-level `[model]`), `objective.*`,
+    /// `optimizer.*` and `optimizers.<label>.*`. Values are TOML (numbers, booleans, quoted strings).
     pub fn read_with(path: &Path, overrides: &[(String, String)]) -> Result<Self> {
         let shown = path.display().to_string();
         let text =
@@ -230,16 +230,7 @@ impl LoadedProblem {
         if overrides.is_empty() {
             return Self::parse(&text, path);
         }
-        let mut doc: toml::Table =
-            toml::from_str(&text).map_err(|e| CzError::config(&shown, e.to_string().trim_end()))?;
-        for (key, raw) in overrides {
-            let value: toml::Value =
-                toml::from_str::<toml::Table>(&format!("v = {raw}")).ok().and_then(|mut t| t.remove("v")).ok_or_else(
-                    || CzError::config(format!("--set {key}"), format!("`{raw}` is not a TOML value (quote strings)")),
-                )?;
-            set_path(&mut doc, key, value).map_err(|m| CzError::config(format!("--set {key}"), m))?;
-        }
-        let edited = toml::to_string(&doc).map_err(|e| CzError::config(&shown, e.to_string()))?;
+        let edited = with_overrides(&text, &shown, overrides)?;
         Self::parse(&edited, path).map_err(|e| Self::blame_override(&text, overrides).unwrap_or(e))
     }
 
@@ -437,6 +428,20 @@ fn find_value(node: &toml::Value, wanted: &toml::Value, path: String, hits: &mut
     }
 }
 
+/// `text` (of the file `shown`) with the values of `overrides` replaced, as
+/// [`LoadedProblem::read_with`] describes; the same for model files (`[law]` and one `[model]`).
+pub fn with_overrides(text: &str, shown: &str, overrides: &[(String, String)]) -> Result<String> {
+    let mut doc: toml::Table = toml::from_str(text).map_err(|e| CzError::config(shown, e.to_string().trim_end()))?;
+    for (key, raw) in overrides {
+        let value: toml::Value =
+            toml::from_str::<toml::Table>(&format!("v = {raw}")).ok().and_then(|mut t| t.remove("v")).ok_or_else(
+                || CzError::config(format!("--set {key}"), format!("`{raw}` is not a TOML value (quote strings)")),
+            )?;
+        set_path(&mut doc, key, value).map_err(|m| CzError::config(format!("--set {key}"), m))?;
+    }
+    toml::to_string(&doc).map_err(|e| CzError::config(shown, e.to_string()))
+}
+
 /// Sets `key` (a parameter-style path) in a problem-file document.
 fn set_path(doc: &mut toml::Table, key: &str, value: toml::Value) -> std::result::Result<(), String> {
     let mut parts: Vec<&str> = key.split('.').collect();
@@ -452,11 +457,22 @@ fn set_path(doc: &mut toml::Table, key: &str, value: toml::Value) -> std::result
                 .as_table_mut()
                 .ok_or("`optimizers` is not a table of named optimizers".to_string())?
         }
+        // A file for `czid simulate` with one top-level [model] and no experiments.
+        Some("model") if parts.len() > 1 => {
+            parts.remove(0);
+            doc.get_mut("model").and_then(|v| v.as_table_mut()).ok_or(
+                "the file has no top-level [model] table (the models of [[experiment]] tables are models.<experiment>.…)",
+            )?
+        }
         Some("models") if parts.len() > 2 => {
             let name = parts[1].to_string();
             parts.drain(..2);
-            let experiments =
-                doc.get_mut("experiment").and_then(|v| v.as_array_mut()).ok_or("the file has no [[experiment]]")?;
+            let why = if doc.contains_key("model") {
+                "the file has no [[experiment]]: its one [model] is reached as model.…"
+            } else {
+                "the file has no [[experiment]]"
+            };
+            let experiments = doc.get_mut("experiment").and_then(|v| v.as_array_mut()).ok_or(why)?;
             let entry = experiments
                 .iter_mut()
                 .filter_map(|e| e.as_table_mut())
@@ -474,7 +490,7 @@ fn set_path(doc: &mut toml::Table, key: &str, value: toml::Value) -> std::result
         }
         _ => {
             return Err(
-                "paths start with law., models.<experiment>., objective., optimizer. or optimizers.<label>.".into()
+                "paths start with law., models.<experiment>., model. (a file with one top-level [model]), objective., optimizer. or optimizers.<label>.".into()
             )
         }
     };

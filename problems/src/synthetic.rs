@@ -222,11 +222,27 @@ impl Default for NoiseSpec {
 impl TruthFile {
     /// Reads and validates a truth file.
     pub fn read(path: &std::path::Path) -> Result<Self> {
+        Self::read_with(path, &[])
+    }
+
+    /// [`TruthFile::read`] with some values replaced, e.g. `("model.a0", "45")` or
+    /// `("law.strength_n", "20")` (`czid simulate --set`; paths as in
+    /// [`crate::problem_file::LoadedProblem::read_with`], the model's as `model.*`).
+    pub fn read_with(path: &std::path::Path, overrides: &[(String, String)]) -> Result<Self> {
         czid_models::registry::ensure_linked();
         let shown = path.display().to_string();
         let text =
             std::fs::read_to_string(path).map_err(|e| CzError::Io { path: shown.clone(), message: e.to_string() })?;
-        let t: TruthFile = toml::from_str(&text).map_err(|e| CzError::config(&shown, e.to_string().trim_end()))?;
+        let t: TruthFile = if overrides.is_empty() {
+            toml::from_str(&text).map_err(|e| CzError::config(&shown, e.to_string().trim_end()))?
+        } else {
+            // The rebuilt file's line numbers would mean nothing to the user: the message names the
+            // overrides instead.
+            let edited = crate::problem_file::with_overrides(&text, &shown, overrides)?;
+            let sets: Vec<String> = overrides.iter().map(|(k, v)| format!("--set {k}={v}")).collect();
+            toml::from_str(&edited)
+                .map_err(|e| CzError::config(format!("{shown} with {}", sets.join(" ")), e.message().trim_end()))?
+        };
         t.law.validate()?;
         t.model.validate()?;
         Ok(t)

@@ -575,3 +575,26 @@ fn truth_files_read_events_with_noise_and_rounding() {
     // Reproducible.
     assert_eq!(t.generate_with_events().unwrap().1, events);
 }
+
+#[test]
+fn overrides_reach_the_one_model_of_a_model_file() {
+    use czid_problems::synthetic::TruthFile;
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/paper-dcb/truth.toml");
+    let set = |k: &str, v: &str| vec![(k.to_string(), v.to_string())];
+    let t = TruthFile::read_with(&file, &set("model.a0", "45")).unwrap();
+    assert_eq!(serde_json::to_value(&t.model).unwrap()["a0"], 45.0);
+    let t = TruthFile::read_with(&file, &set("law.strength_n", "20")).unwrap();
+    assert_eq!(serde_json::to_value(&t.law).unwrap()["strength_n"], 20.0);
+    for (key, value, expect) in [
+        ("models.model.a0", "45", "its one [model] is reached as model."),
+        ("model.a00", "45", "--set model.a00=45"),
+        ("model.a0", "-1", "a0"),
+    ] {
+        let e = TruthFile::read_with(&file, &set(key, value)).err().unwrap().to_string();
+        assert!(e.contains(expect), "{key}: {e}");
+    }
+    // A problem file has no top-level model.
+    let dir = setup_dir("model-override", &problem_text(""));
+    let e = LoadedProblem::read_with(&dir.join("problem.toml"), &set("model.a0", "1")).unwrap_err().to_string();
+    assert!(e.contains("no top-level [model]"), "{e}");
+}
