@@ -146,22 +146,7 @@ impl Quad {
         let mut r = Vector4::zeros();
         let mut k = Matrix4::zeros();
         for p in points {
-            let mut h: Matrix2<f64> = Matrix2::zeros();
-            for m in 0..6 {
-                let (ux, uy) =
-                    if m < 4 { (u[2 * m], u[2 * m + 1]) } else { (alpha[2 * (m - 4)], alpha[2 * (m - 4) + 1]) };
-                for j in 0..2 {
-                    h[(0, j)] += ux * p.grads[m][j];
-                    h[(1, j)] += uy * p.grads[m][j];
-                }
-            }
-            let f = if large { Matrix2::identity() + h } else { Matrix2::identity() };
-            let strain = if large {
-                let e = 0.5 * (h + h.transpose() + h.transpose() * h);
-                Vector3::new(e[(0, 0)], e[(1, 1)], 2.0 * e[(0, 1)])
-            } else {
-                Vector3::new(h[(0, 0)], h[(1, 1)], h[(0, 1)] + h[(1, 0)])
-            };
+            let (f, strain) = strains(p, u, alpha, large);
             let s: Vector3<f64> = d * strain;
             let mut b = SMatrix::<f64, 3, 4>::zeros();
             for m in 4..6 {
@@ -197,23 +182,7 @@ impl Quad {
         let mut k = SMatrix::<f64, 12, 12>::zeros();
         let mut energy = 0.0;
         for p in points {
-            // Displacement gradient H[i][j] = ∂u_i/∂X_j, enhanced by the bubbles.
-            let mut h: Matrix2<f64> = Matrix2::zeros();
-            for m in 0..6 {
-                let (ux, uy) =
-                    if m < 4 { (u[2 * m], u[2 * m + 1]) } else { (alpha[2 * (m - 4)], alpha[2 * (m - 4) + 1]) };
-                for j in 0..2 {
-                    h[(0, j)] += ux * p.grads[m][j];
-                    h[(1, j)] += uy * p.grads[m][j];
-                }
-            }
-            let f = if large { Matrix2::identity() + h } else { Matrix2::identity() };
-            let strain = if large {
-                let e = 0.5 * (h + h.transpose() + h.transpose() * h);
-                Vector3::new(e[(0, 0)], e[(1, 1)], 2.0 * e[(0, 1)])
-            } else {
-                Vector3::new(h[(0, 0)], h[(1, 1)], h[(0, 1)] + h[(1, 0)])
-            };
+            let (f, strain) = strains(p, u, alpha, large);
             let s: Vector3<f64> = d * strain;
             energy += 0.5 * strain.dot(&s) * p.weight;
             // B columns: δE of a unit value of each of the 12 unknowns.
@@ -245,6 +214,27 @@ impl Quad {
         }
         Full { r, k, energy }
     }
+}
+
+/// At one Gauss point: the deformation gradient `F` (the identity in small strain) and the strain
+/// `[E₁₁, E₂₂, 2E₁₂]` from the displacement gradient `H[i][j] = ∂u_i/∂X_j`, enhanced by the bubbles.
+fn strains(p: &Point, u: &ElementForce, alpha: &Vector4<f64>, large: bool) -> (Matrix2<f64>, Vector3<f64>) {
+    let mut h: Matrix2<f64> = Matrix2::zeros();
+    for m in 0..6 {
+        let (ux, uy) = if m < 4 { (u[2 * m], u[2 * m + 1]) } else { (alpha[2 * (m - 4)], alpha[2 * (m - 4) + 1]) };
+        for j in 0..2 {
+            h[(0, j)] += ux * p.grads[m][j];
+            h[(1, j)] += uy * p.grads[m][j];
+        }
+    }
+    let f = if large { Matrix2::identity() + h } else { Matrix2::identity() };
+    let strain = if large {
+        let e = 0.5 * (h + h.transpose() + h.transpose() * h);
+        Vector3::new(e[(0, 0)], e[(1, 1)], 2.0 * e[(0, 1)])
+    } else {
+        Vector3::new(h[(0, 0)], h[(1, 1)], h[(0, 1)] + h[(1, 0)])
+    };
+    (f, strain)
 }
 
 struct Full {
