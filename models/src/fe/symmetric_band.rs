@@ -172,7 +172,7 @@ impl SymmetricBand {
         for k in (0..n).rev() {
             let hi = bw.min(n - 1 - k);
             let l = &self.data[k * w + 1..k * w + 1 + hi];
-            let s: f64 = l.iter().zip(&b[k + 1..k + 1 + hi]).map(|(a, x)| a * x).sum();
+            let s = l.iter().zip(&b[k + 1..k + 1 + hi]).rev().fold(0.0, |s, (a, x)| s + a * x);
             b[k] -= s;
         }
     }
@@ -213,7 +213,7 @@ impl SymmetricBand {
             let x1: &[f64; BW] = b1[k + 1..k + 1 + BW].try_into().unwrap();
             let x2: &[f64; BW] = b2[k + 1..k + 1 + BW].try_into().unwrap();
             let (mut s1, mut s2) = (0.0, 0.0);
-            for t in 0..BW {
+            for t in (0..BW).rev() {
                 s1 += l[t] * x1[t];
                 s2 += l[t] * x2[t];
             }
@@ -244,14 +244,16 @@ impl SymmetricBand {
         }
     }
 
-    /// `Lᵀ x = z` for the unknowns `rows` (those after done), in reverse order.
+    /// `Lᵀ x = z` for the unknowns `rows` (those after done), in reverse order; each sum takes
+    /// the farthest unknowns first, so only its last product waits for the previous row
+    /// (see `BandMatrix`'s back substitution).
     fn backward2_rows(&self, rows: std::ops::Range<usize>, b1: &mut [f64], b2: &mut [f64]) {
         let (n, bw, w) = (self.n, self.bw, self.width);
         for k in rows.rev() {
             let hi = bw.min(n - 1 - k);
             let l = &self.data[k * w + 1..k * w + 1 + hi];
             let (mut s1, mut s2) = (0.0, 0.0);
-            for ((a, x1), x2) in l.iter().zip(&b1[k + 1..k + 1 + hi]).zip(&b2[k + 1..k + 1 + hi]) {
+            for ((a, x1), x2) in l.iter().zip(&b1[k + 1..k + 1 + hi]).zip(&b2[k + 1..k + 1 + hi]).rev() {
                 s1 += a * x1;
                 s2 += a * x2;
             }
