@@ -309,8 +309,9 @@ fn how_far_section(s: &mut String, d: &Diagnosis) {
             .collect();
         let _ = writeln!(
             s,
-            "| {} | {:.1} | {:.0}% | {:.1} | {:.1} | {} | {} |",
+            "| {}{} | {:.1} | {:.0}% | {:.1} | {:.1} | {} | {} |",
             c.name,
+            if c.on_request { " (refitted on request, not judged)" } else { "" },
             r.chi2,
             100.0 * r.shrinkage,
             r.delta_aic,

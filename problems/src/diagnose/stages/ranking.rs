@@ -79,6 +79,7 @@ pub fn rank(base: &Base, lin: &Linearisation, chosen: Vec<Arc<dyn CandidateEffec
                 error,
                 refit: None,
                 transfer: Vec::new(),
+                on_request: false,
             };
             Ranked { effect: c.clone(), result, sensitivity }
         })

@@ -94,7 +94,7 @@ pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusab
     }
     let provisional = !reasons.is_empty();
     let mut qualified: Vec<&CandidateResult> = Vec::new();
-    for c in candidates {
+    for c in candidates.iter().filter(|c| !c.on_request) {
         let Some(r) = &c.refit else { continue };
         if r.delta_bic > -EVIDENCE {
             continue;
@@ -218,6 +218,7 @@ pub fn text(
             }
             let best = candidates
                 .iter()
+                .filter(|c| !c.on_request)
                 .filter_map(|c| c.refit.as_ref().map(|r| (c, r)))
                 .max_by(|a, b| a.1.shrinkage.total_cmp(&b.1.shrinkage));
             match best {
@@ -359,7 +360,22 @@ mod tests {
                 })
                 .into_iter()
                 .collect(),
+            on_request: false,
         }
+    }
+
+    #[test]
+    fn a_refit_made_only_on_request_takes_no_part_in_the_verdict() {
+        // "b" removes most, but it was refitted only because the caller asked (a benchmark's
+        // planted effect that the diagnosis itself would not have refitted).
+        let mut b = candidate("b", Some((400.0, 0.5, -300.0)), None);
+        b.on_request = true;
+        let cs = [candidate("a", Some((700.0, 0.12, -60.0)), None), b];
+        let o = decide(&base(2.0), 400, &cs, &[]);
+        assert_eq!((o.kind, o.cause.as_deref()), (Kind::Cause, Some("a")));
+        let only = [cs[1].clone()];
+        let o = decide(&base(2.0), 400, &only, &[]);
+        assert_eq!((o.kind, o.cause), (Kind::Unexplained, None));
     }
 
     #[test]
