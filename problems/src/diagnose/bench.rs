@@ -127,6 +127,10 @@ pub struct CaseResult {
     pub true_at_noise_level: Option<bool>,
     /// The true effect's values found by the refit.
     pub true_refit: Vec<f64>,
+    /// Whether the true effect was refitted only on request: the diagnosis itself did not refit
+    /// it, so the verdict could not name it.
+    #[serde(default)]
+    pub true_refit_on_request: bool,
     /// Candidates that could not be scored or refitted, with the reason.
     pub notes: Vec<String>,
     /// Cosines between candidates (beyond the fitted parameters) at this case's base fit.
@@ -227,6 +231,7 @@ fn case(
         true_reduced_chi2: None,
         true_at_noise_level: None,
         true_refit: Vec::new(),
+        true_refit_on_request: false,
         notes: Vec::new(),
         pairs: Vec::new(),
         redraws: 0,
@@ -392,6 +397,7 @@ fn record_diagnosis(out: &mut CaseResult, d: &Diagnosis, planted: &str) {
     if let Some(c) = d.candidates.iter().find(|c| c.name == planted) {
         if let Some(r) = &c.refit {
             out.true_refit = r.effect.iter().map(|v| v.value).collect();
+            out.true_refit_on_request = c.on_request;
             let dof = d.readings.saturating_sub(r.parameters.len() + r.effect.len()).max(1) as f64;
             let chi2 = r.chi2_reestimated.unwrap_or(r.chi2);
             out.true_reduced_chi2 = Some(chi2 / dof);
@@ -789,8 +795,15 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
     );
     let _ = writeln!(
         s,
-        "Refitting the true effect brings the misfit to the noise level in {:.0}% of the planted cases.\n",
+        "Refitting the true effect brings the misfit to the noise level in {:.0}% of the planted cases.",
         100.0 * r.true_effect_at_noise_level
+    );
+    let requested = r.cases.iter().filter(|c| c.true_refit_on_request).count();
+    let planted = r.cases.iter().filter(|c| c.planted != NONE && c.planted != GAIN).count();
+    let _ = writeln!(
+        s,
+        "The true effect was refitted only on request (not among the diagnosis's own refits, so not \
+         nameable) in {requested} of {planted} planted cases.\n"
     );
     let _ = writeln!(s, "Confusable pairs predicted by the Jacobian angles (mean cosine > {CONFUSABLE}):\n");
     if r.confusable.is_empty() {
