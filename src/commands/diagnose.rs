@@ -37,10 +37,10 @@ pub struct DiagnoseArgs {
     /// Candidate effects to score, comma separated (default: every one that applies).
     #[arg(long, value_delimiter = ',')]
     pub candidates: Vec<String>,
-    /// At most how many significant candidates to refit (best score first); the cause is decided
-    /// on the refits.
-    #[arg(long, default_value_t = 5)]
-    pub refit: usize,
+    /// At most how many significant candidates to refit (best score first; default: every
+    /// significant one); the cause is decided on the refits.
+    #[arg(long)]
+    pub refit: Option<usize>,
     /// Judge the candidates against the noise alone, without accounting for the misfit the base
     /// model's form leaves (estimated with its reference model, e.g. the continuum DCB).
     #[arg(long)]
@@ -98,7 +98,7 @@ pub fn run(args: &DiagnoseArgs, cluster: &Cluster) -> Result<(), CzError> {
     let mut opts = Options {
         candidates: args.candidates.clone(),
         start,
-        refit: args.refit,
+        refit: args.refit.unwrap_or(usize::MAX),
         noise: NoiseLevels { load: args.noise_load, length: args.noise_length },
         withheld,
         holdout: !args.no_holdout,

@@ -33,7 +33,9 @@ pub struct Options {
     /// `identify` result; `None`: fit with the problem file's optimizer first.
     pub start: Option<Vec<f64>>,
     /// At most how many significant candidates to refit (best score first); every significant
-    /// one up to this number is refitted, and the cause is decided on the refits.
+    /// one up to this number is refitted, and the cause is decided on the refits. The default
+    /// (`usize::MAX`) refits every significant candidate: the cause is the refit that removes
+    /// most, which need not be among the best scores.
     pub refit: usize,
     /// Noise levels instead of estimates from the data.
     pub noise: NoiseLevels,
@@ -60,7 +62,7 @@ impl Default for Options {
         Options {
             candidates: Vec::new(),
             start: None,
-            refit: 5,
+            refit: usize::MAX,
             noise: NoiseLevels::default(),
             withheld: Vec::new(),
             holdout: true,
