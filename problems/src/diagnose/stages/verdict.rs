@@ -81,7 +81,8 @@ fn refit_dof(n: usize, c: &CandidateResult) -> f64 {
 /// readings.
 pub fn decide(base: &BaseFit, n: usize, candidates: &[CandidateResult], confusable: &[Confusable]) -> Outcome {
     let mut reasons = Vec::new();
-    for c in candidates {
+    // A refit made only on request failing says nothing about the diagnosis's own verdict.
+    for c in candidates.iter().filter(|c| !c.on_request) {
         if let Some(e) = &c.error {
             reasons.push(format!("{} could not be evaluated: {e}", c.name));
         }
@@ -376,6 +377,11 @@ mod tests {
         let only = [cs[1].clone()];
         let o = decide(&base(2.0), 400, &only, &[]);
         assert_eq!((o.kind, o.cause), (Kind::Unexplained, None));
+        // Nor does its failure make the verdict provisional.
+        let mut failed = candidate("b", None, None);
+        (failed.on_request, failed.error) = (true, Some("refit failed: no convergence".into()));
+        let o = decide(&base(2.0), 400, &[cs[0].clone(), failed], &[]);
+        assert_eq!((o.cause.as_deref(), o.provisional), (Some("a"), false), "{:?}", o.reasons);
     }
 
     #[test]
