@@ -417,12 +417,7 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
     let holdout = Holdout::prepare(&base, &regs, &lin, opts.holdout, &say)?;
     let withheld = Withheld::prepare(&base, &opts.withheld, opts.noise)?;
     let above_noise = base.p_noise <= NOISE_LEVEL;
-    let todo = ranking.to_refit(opts.refit, above_noise, &[]);
-    let requested = ranking.to_refit(opts.refit, above_noise, &opts.always_refit);
-    for &i in requested.iter().filter(|i| !todo.contains(i)) {
-        ranking.ranked[i].result.on_request = true;
-    }
-    let todo = requested;
+    let todo = ranking.to_refit(opts.refit, above_noise, &opts.always_refit);
     let farm = opts.farm.as_deref().unwrap_or(&Threads);
     let Some(mut refits) =
         refit_candidates(&base, &lin, &regs, &mut ranking, &todo, (holdout.as_ref(), &withheld), &say, farm)?

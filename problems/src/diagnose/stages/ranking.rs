@@ -105,8 +105,10 @@ impl Ranking {
     /// Indices of the candidates to refit: every significant one, best score first, up to
     /// `refit`; when the base fit is `above_noise`, the two best scored at least (an effect the
     /// first-order score underrates may still remove the misfit); plus any named in `always`
-    /// (e.g. a benchmark's planted effect).
-    pub fn to_refit(&self, refit: usize, above_noise: bool, always: &[String]) -> Vec<usize> {
+    /// (e.g. a benchmark's planted effect), which are marked
+    /// [`CandidateResult::on_request`](crate::diagnose::run::CandidateResult::on_request) when
+    /// the diagnosis would not have refitted them itself.
+    pub fn to_refit(&mut self, refit: usize, above_noise: bool, always: &[String]) -> Vec<usize> {
         let scored: Vec<usize> = (0..self.ranked.len())
             .filter(|&i| self.ranked[i].result.score.as_ref().is_some_and(|s| s.dof > 0))
             .collect();
@@ -124,6 +126,9 @@ impl Ranking {
             .copied()
             .filter(|&i| !top.contains(&i) && always.contains(&self.ranked[i].result.name))
             .collect();
+        for &i in &extra {
+            self.ranked[i].result.on_request = true;
+        }
         top.extend(extra);
         top
     }
