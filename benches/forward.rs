@@ -76,9 +76,9 @@ fn forward(c: &mut Criterion) {
     let mut enf = Enf::hartlen_enf03();
     enf.mesh.interface_element = 0.25;
     enf.mesh.interface_subdivision = 1;
-    enf.material.e11 = 34_046.7;
+    enf.material.e11 = 34_106.0;
     enf.control.max_displacement = Some(5.58);
-    let mode_two = Bilinear::bk(1e5, 30.0, 29.019, 0.8, 3.3433, 2.0).unwrap();
+    let mode_two = Bilinear::bk(1e5, 30.0, 28.809, 0.8, 3.3386, 2.0).unwrap();
     g.bench_function("enf_hartlen03_identified", |b| b.iter(|| enf.simulate(&mode_two).unwrap()));
     let mut mmb = Mmb::hartlen(43.722);
     mmb.control.max_displacement = Some(7.0);

@@ -40,7 +40,7 @@ pub struct Enf {
     #[serde(default)]
     pub contact_stiffness: Option<f64>,
     /// Element sizes (`interface_element` from the crack front to the loading nose, where the
-    /// crack runs; `arm_element` elsewhere).
+    /// crack runs, and for two arm thicknesses past the nose; `arm_element` elsewhere).
     #[serde(default)]
     pub mesh: MeshSettings,
     /// Loading and output; `control.max_displacement` is the final load-point deflection (mm),
@@ -133,7 +133,16 @@ impl Enf {
         let l = self.half_span;
         let (fine, coarse) = (self.mesh.crack_element(), self.mesh.arm_element);
         let outer = coarse.min(4.0 * self.mesh.interface_element);
-        let x = graded(&[0.0, a, l, 2.0 * l], &[outer, fine, outer]);
+        // Under the loading nose the interface carries the load's local stresses, which decay over
+        // about a millimetre (the arm on its elastic interface). Two arm thicknesses past the nose
+        // keep interface elements: a point reaching its strength there must not be one of the
+        // arms' coarse ones, at which Newton cycles and the path creeps.
+        let past = l + 2.0 * self.h;
+        let x = if past + outer < 2.0 * l {
+            graded(&[0.0, a, l, past, 2.0 * l], &[outer, fine, self.mesh.interface_element.min(outer), outer])
+        } else {
+            graded(&[0.0, a, l, 2.0 * l], &[outer, fine, outer])
+        };
         let nn = x.len();
         let tip = x.iter().position(|&v| (v - a).abs() <= 1e-9 * l).unwrap_or(0);
         let mid = x.iter().position(|&v| (v - l).abs() <= 1e-9 * l).unwrap_or(nn / 2);
