@@ -219,3 +219,46 @@ fn the_interface_past_the_loading_nose_is_meshed_finely_enough_for_the_path_to_f
     let past = x.iter().position(|v| *v >= e.half_span + 2.0 * e.h - 1e-9).unwrap();
     assert!(x[mid..=past].windows(2).all(|w| w[1] - w[0] <= 0.25 + 1e-9), "{:?}", &x[mid..=past]);
 }
+
+/// The law of the test above on the mesh the ENF model used before (the arms' 1 mm elements from
+/// the load nose on), built from the public engine: there Newton cycles at the first coarse point
+/// past the nose, and neither control converges on a longer step. Dissipation control still
+/// converges on tiny ones, each releasing its energy at a standstill (about 1.6 µm and 10⁻³ N a
+/// step); the path crept through 4600 of them (13 s) before jumping. It now jumps after
+/// `CREEP_STEPS` of them, and every state it records is one the creeping run recorded too.
+#[test]
+fn a_dissipation_controlled_path_at_a_standstill_jumps_instead_of_creeping() {
+    use czid_models::beamtest::cracked_arms_interface;
+    use czid_models::fe::mesh::graded;
+    use czid_models::fe::{self, FeProblem, Layer, Mesh, RunOptions};
+    let law = Bilinear::bk(1e5, 9.73, 29.10, 0.825, 3.591, 3.95).unwrap();
+    let mut e = Enf { a0: 33.5, ..Enf::hartlen_enf03() };
+    e.material.e11 = 32_704.0;
+    let (a, l, h, target) = (e.a0, e.half_span, e.h, 5.58);
+    let x = graded(&[0.0, a, l, 2.0 * l], &[1.0, 0.25, 1.0]);
+    let at = |v: f64| x.iter().position(|xi| (xi - v).abs() < 1e-9).unwrap();
+    let (tip, mid, nn) = (at(a), at(l), x.len());
+    let (base, _) = e.problem(&law).unwrap();
+    let section = base.mesh.layers[0].section;
+    let layer = |y: f64| Layer { section, y, axial: true, first: 0, last: nn - 1 };
+    let mesh = Mesh::new(x, vec![layer(0.5 * h), layer(1.5 * h)], 0).unwrap();
+    let p = FeProblem {
+        points: cracked_arms_interface(&mesh, tip, nn - 1, e.width),
+        springs: Vec::new(),
+        fixed: vec![mesh.dofs(0, 0)[1], mesh.dofs(0, nn - 1)[1], mesh.dofs(0, nn - 1)[0]],
+        control: mesh.dofs(1, mid)[1],
+        large_rotation: false,
+        contact_stiffness: 1e5,
+        contact_friction: 0.0,
+        mesh,
+    };
+    // The nose pushes down: the control unknown goes to −5.58 mm.
+    let path = e.control.path(-target, a).with_visible_front(&law, 1);
+    let (rows, stats) =
+        fe::run_with(&p, &law, &path, &RunOptions::segments()).unwrap_or_else(|f| panic!("{}", f.error));
+    println!("{stats:?}");
+    assert!(stats.dissipation_steps > 0, "the path no longer stands still here: {stats:?}");
+    assert!(stats.dissipation_steps <= 3 * fe::path::CREEP_STEPS, "{stats:?}");
+    assert!(stats.steps <= 2 * e.control.output_points, "{stats:?}");
+    assert!((rows.last().unwrap().control + target).abs() < 1e-9 * target);
+}
