@@ -392,6 +392,7 @@ impl ControlSettings {
             visible_kink: None,
             crack_origin,
             newton: crate::fe::NewtonSettings { max_iterations: self.max_iterations, tolerance: self.tolerance },
+            end_at_separation: false,
         }
     }
 }

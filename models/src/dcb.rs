@@ -202,7 +202,7 @@ impl Dcb {
         let grown = record.column(czid_core::columns::DEBONDED_LENGTH).ok()?;
         let mut most = 0.0f64;
         for (i, (&u, &l)) in elastic.iter().zip(grown).enumerate() {
-            if l > 0.0 && u < 0.01 * most {
+            if fe::run_types::separated(u, most, l) {
                 return Some(i);
             }
             most = most.max(u);
@@ -304,10 +304,10 @@ impl Dcb {
     }
 
     fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
-        // The debonded length is the visible crack (what a camera sees).
-        self.control
-            .path(self.max_opening(law) / scale.displacement, self.effective_crack_length())
-            .with_visible_front(law, 0)
+        // The debonded length is the visible crack (what a camera sees). The record ends where the
+        // arms have sprung back (`until_split`): the run need not go further.
+        let path = self.control.path(self.max_opening(law) / scale.displacement, self.effective_crack_length());
+        PathSettings { end_at_separation: true, ..path.with_visible_front(law, 0) }
     }
 }
 

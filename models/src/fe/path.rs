@@ -37,7 +37,7 @@ use super::energy::{self, Ledger};
 use super::fine_zone::FineZone;
 use super::interface::{PointKind, SIDE};
 use super::newton::{Newton, StepFailure};
-use super::run_types::{FrontTrack, PathFailure, PathSettings, RunOptions, RunStats, StepRow};
+use super::run_types::{separated, FrontTrack, PathFailure, PathSettings, RunOptions, RunStats, StepRow};
 
 struct State {
     q: Vec<f64>,
@@ -75,7 +75,7 @@ pub fn run_with(
         return Err(run.fail("the path needs a finite, non-zero target and at least one output".into()));
     }
     let mut path = Control::new(s);
-    while path.pos < path.target - path.eps {
+    while path.pos < path.target - path.eps && !run.separated {
         if run.stats.steps > path.max_steps {
             let msg = format!("gave up after {} steps at control {:.6}", run.stats.steps, path.dir * path.pos);
             return Err(run.fail(msg));
@@ -209,6 +209,10 @@ struct WholeMesh<'a> {
     last_diss: f64,
     tau_hint: f64,
     front: FrontTrack,
+    /// Largest elastic energy recorded so far, and whether the specimen has come apart
+    /// ([`PathSettings::end_at_separation`]).
+    most_elastic: f64,
+    separated: bool,
     /// Under large rotations, the intact part far ahead of the crack front left out of the solve.
     cut: Option<Cut>,
 }
@@ -388,6 +392,8 @@ impl<'a> WholeMesh<'a> {
             last_diss: 0.0,
             tau_hint: 0.0,
             front: FrontTrack::default(),
+            most_elastic: 0.0,
+            separated: false,
             cut: if o.cut_far_field { Cut::of(p, law, segments) } else { None },
         }
     }
@@ -699,11 +705,14 @@ impl<'a> WholeMesh<'a> {
         if record {
             let structural = self.nw.asm.structural_energy(p, &self.cur.q);
             let crack = self.crack_measures();
+            let elastic = structural + stored;
+            self.separated = self.s.end_at_separation && separated(elastic, self.most_elastic, crack.debonded);
+            self.most_elastic = self.most_elastic.max(elastic);
             self.rows.push(StepRow {
                 control: self.cur.q[ic],
                 reaction,
                 external_work: self.ledger.external_work,
-                elastic_energy: structural + stored,
+                elastic_energy: elastic,
                 dissipated_energy: dissipated,
                 crack,
                 shear_work: Some(self.ledger.shear_work),

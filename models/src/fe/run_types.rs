@@ -32,6 +32,23 @@ pub struct PathSettings {
     pub crack_origin: f64,
     /// Newton settings.
     pub newton: NewtonSettings,
+    /// End the run, successfully, at the first recorded state where the specimen has come apart
+    /// ([`separated`]): a split DCB's arms spring back, and the states that follow describe no
+    /// test (the dissipation constraint then drives the opening below zero, the arms pressed into
+    /// each other with growing energy, until nothing converges). Off by default.
+    pub end_at_separation: bool,
+}
+
+/// Share of the largest elastic energy so far below which a state whose crack has grown is one
+/// where the specimen has come apart ([`separated`]).
+pub const SEPARATED_ENERGY_SHARE: f64 = 0.01;
+
+/// Whether a recorded state with stored elastic energy `elastic` and debonded length `debonded`,
+/// after states whose largest elastic energy was `most`, is one where the specimen has come apart:
+/// the crack has grown and the energy has fallen below [`SEPARATED_ENERGY_SHARE`] of `most` (the
+/// arms have sprung back).
+pub fn separated(elastic: f64, most: f64, debonded: f64) -> bool {
+    debonded > 0.0 && elastic < SEPARATED_ENERGY_SHARE * most
 }
 
 impl PathSettings {
@@ -48,6 +65,7 @@ impl PathSettings {
             visible_kink: None,
             crack_origin,
             newton: NewtonSettings::default(),
+            end_at_separation: false,
         }
     }
 

@@ -477,6 +477,7 @@ impl FrpPull {
             visible_kink: None,
             crack_origin: 0.0,
             newton: self.newton(),
+            end_at_separation: false,
         }
     }
 
