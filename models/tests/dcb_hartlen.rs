@@ -103,3 +103,45 @@ fn the_engine_ends_a_split_specimens_run_where_its_arms_spring_back() {
         assert_eq!(a.values[..], b.values[..rec.rows()], "column {}", a.name);
     }
 }
+
+#[test]
+fn a_run_the_window_gives_up_on_goes_on_from_its_state_on_the_whole_mesh() {
+    // The law of the test above: the window cannot follow the split's snap-back. The whole mesh
+    // goes on from the window's last committed state (not from rest): its rows agree with a
+    // whole-mesh run from rest up to the snap-back, the energies still balance, and the run ends
+    // where the arms have sprung back.
+    use czid_models::fe::run_types::separated;
+    use czid_models::fe::RunOptions;
+    let mut d = Dcb::hartlen_dcb01();
+    d.a0 = 33.005;
+    d.control.max_displacement = Some(36.9);
+    let law = Bilinear::bk(1e5, 24.38, 1.3 * 24.38, 0.3, 0.6, 2.0).unwrap();
+    let (resumed, stats) = dcb::simulate_with_stats(&d, &law).unwrap_or_else(|e| panic!("{e}"));
+    let from_rest = RunOptions { window: false, ..dcb::RUN_OPTIONS };
+    let (whole, _) = dcb::simulate_with_options(&d, &law, &from_rest).unwrap_or_else(|e| panic!("{e}"));
+    println!("{stats:?}; {} and {} rows", resumed.rows(), whole.rows());
+    assert_eq!(stats.window_fallback, Some("no convergence even with the smallest step"), "{stats:?}");
+    assert!(stats.resumed_from_window, "{stats:?}");
+    let (x, p) = (col(&resumed, columns::DISPLACEMENT), col(&resumed, columns::LOAD));
+    let (xw, pw) = (col(&whole, columns::DISPLACEMENT), col(&whole, columns::LOAD));
+    let peak = p.iter().fold(0.0f64, |m, v| m.max(*v));
+    // Up to the last output abscissa before the snap-back both record the same states (the
+    // window's and the whole mesh's solutions differ by round-off).
+    let common = x.iter().zip(xw).take_while(|(a, b)| (*a - *b).abs() <= 1e-9 * a.abs().max(1.0)).count();
+    assert!(common + 5 >= x.len().min(xw.len()), "only {common} of {} rows in common", x.len());
+    for i in 0..common {
+        assert!((p[i] - pw[i]).abs() <= 1e-7 * peak, "row {i}: {} against {}", p[i], pw[i]);
+    }
+    let (w, e, dis) = (
+        col(&resumed, columns::EXTERNAL_WORK),
+        col(&resumed, columns::ELASTIC_ENERGY),
+        col(&resumed, columns::DISSIPATED_ENERGY),
+    );
+    for i in 5..resumed.rows() {
+        assert!((w[i] - e[i] - dis[i]).abs() <= 0.01 * w[i], "row {i}: W {} U {} D {}", w[i], e[i], dis[i]);
+    }
+    let grown = col(&resumed, columns::DEBONDED_LENGTH);
+    let last = resumed.rows() - 1;
+    let most = e[..last].iter().fold(0.0f64, |m, v| m.max(*v));
+    assert!(separated(e[last], most, grown[last]), "the run must end where the arms have sprung back");
+}

@@ -45,6 +45,12 @@ impl Ledger {
         }
     }
 
+    /// A ledger that goes on from a state reached elsewhere: the totals so far, and each point's
+    /// committed traction and gap.
+    pub(crate) fn resumed(external_work: f64, interface_work: f64, tractions: Vec<Traction>, gaps: Vec<Gap>) -> Self {
+        Ledger { external_work, interface_work, shear_work: 0.0, tractions, gaps }
+    }
+
     /// The committed tractions and gaps after the problem's points changed: `point_of[i]` is the
     /// old point the new point `i` was, or `None` for a point that `fresh(i)` gives. The totals keep
     /// the work done on every point, the removed ones included.

@@ -24,7 +24,8 @@
 //!   still equilibria).
 //! * **Window.** With [`RunOptions::window`] a problem that fits is solved by `fe::window`
 //!   (displacement control on the unknowns around the crack front only); anything else, and any
-//!   run the window gives up on, by the whole-mesh solver here.
+//!   run the window gives up on, by the whole-mesh solver here, which goes on from the window's
+//!   last committed state when the window gave up part way.
 //! * A run that still fails returns the error and every row that converged.
 
 use std::rc::Rc;
@@ -37,7 +38,7 @@ use super::energy::{self, Ledger};
 use super::fine_zone::FineZone;
 use super::interface::{PointKind, SIDE};
 use super::newton::{Newton, StepFailure};
-use super::run_types::{separated, FrontTrack, PathFailure, PathSettings, RunOptions, RunStats, StepRow};
+use super::run_types::{separated, FrontTrack, PathFailure, PathSettings, Resume, RunOptions, RunStats, StepRow};
 
 struct State {
     q: Vec<f64>,
@@ -60,14 +61,14 @@ pub fn run_with(
     s: &PathSettings,
     o: &RunOptions,
 ) -> Result<(Vec<StepRow>, RunStats), PathFailure> {
-    let mut fallback = None;
+    let (mut fallback, mut resume) = (None, None);
     if o.window && o.interface == InterfaceRule::Segments {
         match super::window::run(p, law, s) {
             Ok((rows, mut stats)) => {
                 stats.windowed = true;
                 return Ok((rows, stats));
             }
-            Err(why) => fallback = Some(why.reason()),
+            Err((why, state)) => (fallback, resume) = (Some(why.reason()), state),
         }
     }
     let mut run = WholeMesh::new(p, law, s, o, fallback);
@@ -75,6 +76,9 @@ pub fn run_with(
         return Err(run.fail("the path needs a finite, non-zero target and at least one output".into()));
     }
     let mut path = Control::new(s);
+    if let Some(state) = resume {
+        run.resume(*state, &mut path);
+    }
     while path.pos < path.target - path.eps && !run.separated {
         if run.stats.steps > path.max_steps {
             let msg = format!("gave up after {} steps at control {:.6}", run.stats.steps, path.dir * path.pos);
@@ -213,6 +217,9 @@ struct WholeMesh<'a> {
     /// ([`PathSettings::end_at_separation`]).
     most_elastic: f64,
     separated: bool,
+    /// Gone on from a windowed run's state ([`WholeMesh::resume`]): the rows carry no shear work
+    /// (the window does not count it).
+    resumed: bool,
     /// Under large rotations, the intact part far ahead of the crack front left out of the solve.
     cut: Option<Cut>,
 }
@@ -394,6 +401,7 @@ impl<'a> WholeMesh<'a> {
             front: FrontTrack::default(),
             most_elastic: 0.0,
             separated: false,
+            resumed: false,
             cut: if o.cut_far_field { Cut::of(p, law, segments) } else { None },
         }
     }
@@ -448,6 +456,53 @@ impl<'a> WholeMesh<'a> {
                     self.trial[dj] = self.cur.q[dj] + du;
                 }
             }
+        }
+    }
+
+    /// Goes on from the state a windowed run reached before it gave up, instead of from rest: the
+    /// window's rows and counters are kept, and the ledger starts from the whole mesh's own view of
+    /// that state (its law results, gaps and stored energy there), so that the dissipated energy
+    /// goes on from the window's. Where the window could not take even its smallest step, the path
+    /// turns back, and the run goes on under the dissipation constraint at once. Left as it was
+    /// if the whole mesh cannot evaluate the state.
+    fn resume(&mut self, r: Resume, c: &mut Control) {
+        let Problem::Given(p) = self.p.clone() else { return };
+        let law = self.law;
+        if r.q.len() != self.cur.q.len() || r.states.len() != p.points.len() {
+            return;
+        }
+        if !self.nw.asm.assemble(p, law, &r.states, &r.q, &mut self.nw.k, &mut self.nw.f, false) {
+            return;
+        }
+        for (i, v) in self.measures.point_stored.iter_mut().enumerate() {
+            let g = &self.nw.asm.gaps[i];
+            *v = match p.points[i].kind {
+                PointKind::Cohesive => law.stored_energy(g, &r.states[i]),
+                PointKind::Contact => super::interface::contact_stored(&self.nw.asm.trial[i], g),
+            };
+        }
+        let stored = self.nw.asm.interface_stored(p, &self.measures.point_stored);
+        let tractions = self.nw.asm.trial.iter().map(|ev| ev.traction).collect();
+        self.ledger = Ledger::resumed(r.external_work, r.dissipated + stored, tractions, self.nw.asm.gaps.to_vec());
+        self.prev_q.copy_from_slice(&r.q);
+        self.cur = State { q: r.q, states: r.states, reaction: r.reaction };
+        self.most_elastic = r.rows.iter().map(|row| row.elastic_energy).fold(0.0, f64::max);
+        self.rows = r.rows;
+        self.last_diss = r.dissipated;
+        self.tau_hint = r.dissipation_hint;
+        self.front = r.front;
+        self.stats =
+            RunStats { window_fallback: Some(r.reason), windowed: false, resumed_from_window: true, ..r.stats };
+        self.nw.counters = (r.stats.assemblies, r.stats.factorizations);
+        self.resumed = true;
+        c.pos = r.pos;
+        c.h = r.h.min(c.spacing);
+        c.h_prev = 0.0;
+        c.k_out = r.k_out;
+        if r.snap_back && self.tau_hint > 0.0 {
+            c.dissipating = true;
+            c.tau = self.tau_hint;
+            c.last = None;
         }
     }
 
@@ -715,7 +770,7 @@ impl<'a> WholeMesh<'a> {
                 elastic_energy: elastic,
                 dissipated_energy: dissipated,
                 crack,
-                shear_work: Some(self.ledger.shear_work),
+                shear_work: (!self.resumed).then_some(self.ledger.shear_work),
             });
         }
         self.follow_front();

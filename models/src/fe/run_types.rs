@@ -5,7 +5,7 @@
 //! depends on the other's module (the whole-mesh solver calls the window; the window only needs
 //! these types).
 
-use czid_core::CzError;
+use czid_core::{CzError, LawState};
 
 use super::assembly::InterfaceRule;
 use super::crack::CrackMeasures;
@@ -130,6 +130,9 @@ pub struct RunStats {
     pub windowed: bool,
     /// Why a run asked to use the window was solved on the whole mesh instead.
     pub window_fallback: Option<&'static str>,
+    /// Whether the whole mesh went on from the window's last committed state (rather than from
+    /// rest) after the window gave up.
+    pub resumed_from_window: bool,
 }
 
 /// A failed run: the error and the converged rows.
@@ -187,6 +190,38 @@ impl RunOptions {
 /// Largest share of the linear prediction of a front's advance that the parabola's curvature may
 /// add or remove before the prediction falls back to the line ([`FrontTrack::advance`]).
 const QUADRATIC_SHARE: f64 = 0.1;
+
+/// The last committed state of a windowed run that gave up, for the whole mesh to go on from
+/// instead of starting again from rest (`fe::window` builds it, `fe::path` resumes it).
+#[derive(Debug)]
+pub(crate) struct Resume {
+    /// Why the window gave up.
+    pub(crate) reason: &'static str,
+    /// The window could not take even its smallest step: the path turns back (a snap-back), so
+    /// the whole mesh goes on under the dissipation constraint.
+    pub(crate) snap_back: bool,
+    /// Every unknown of the problem, the control one included.
+    pub(crate) q: Vec<f64>,
+    /// Every interface point's law state.
+    pub(crate) states: Vec<LawState>,
+    /// Load on the control unknown.
+    pub(crate) reaction: f64,
+    /// Work of the load, and energy the interface has dissipated (N·mm).
+    pub(crate) external_work: f64,
+    pub(crate) dissipated: f64,
+    /// Energy the interface dissipated in the last step that dissipated, for the dissipation
+    /// constraint to start from.
+    pub(crate) dissipation_hint: f64,
+    /// Rows recorded so far, and the run's counters.
+    pub(crate) rows: Vec<StepRow>,
+    pub(crate) stats: RunStats,
+    /// Where the path stands: position along the control, next step, next output abscissa.
+    pub(crate) pos: f64,
+    pub(crate) h: f64,
+    pub(crate) k_out: usize,
+    /// The front's recent positions.
+    pub(crate) front: FrontTrack,
+}
 
 /// The most advanced onset front of the segment rule over the last three commits, for predicting
 /// how far it moves in the next step.

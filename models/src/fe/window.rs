@@ -20,7 +20,10 @@
 //! lengths `(4EI/k_f)^{1/4}` of the beam on its elastic interface from the window (beyond which a
 //! perturbation has decayed by e⁻¹⁰) and their gaps checked; at the end of the run every point is
 //! checked. A step whose check fails is repeated with a wider window; a run whose final check fails
-//! (or that does not fit the assumptions) is repeated on the whole mesh by [`super::path`].
+//! (or that does not fit the assumptions) is repeated on the whole mesh by [`super::path`]. A run
+//! that gives up part way, where the path turns back (a specimen splitting) or the window reaches
+//! the far end, hands its last committed state to the whole mesh, which goes on from there
+//! (`Resume`) instead of starting again from rest.
 //!
 //! **Cost.** The right region is eliminated once per run (from the far end: the elimination up to
 //! any node is a prefix of the same sweep), the left one incrementally as points fail and leave the
@@ -43,7 +46,7 @@ use super::energy::path_work;
 use super::interface::{self, PointKind, POINT_DOFS};
 use super::mesh::NONE;
 use super::pool::{self, Pooled};
-use super::run_types::{FrontTrack, PathSettings, RunStats, StepRow};
+use super::run_types::{FrontTrack, PathSettings, Resume, RunStats, StepRow};
 use super::segment::{self, End, ModeOne, Segment};
 
 /// Largest number of unknowns per node the window handles.
@@ -528,6 +531,15 @@ enum Verdict {
     Left,
 }
 
+/// Where a windowed run stands along its path (for [`Resume`]).
+struct Cursor {
+    pos: f64,
+    h: f64,
+    k_out: usize,
+    external: f64,
+    front: FrontTrack,
+}
+
 /// Per-point bookkeeping of the interface.
 #[derive(Clone, Copy, Debug)]
 struct PointRecord {
@@ -560,8 +572,13 @@ impl PointRecord {
     }
 }
 
-/// Solves `p` along `s` with the window; the rows at the output abscissae.
-pub(crate) fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Vec<StepRow>, RunStats), Unfit> {
+/// Why a windowed run gave up, and the state it reached when the whole mesh can go on from it.
+pub(crate) type GaveUp = (Unfit, Option<Box<Resume>>);
+
+/// Solves `p` along `s` with the window; the rows at the output abscissae. A run that gives up
+/// where the path turns back or the window reaches the far end also returns its last committed
+/// state, for the whole mesh to go on from.
+pub(crate) fn run(p: &FeProblem, law: &dyn CohesiveLaw, s: &PathSettings) -> Result<(Vec<StepRow>, RunStats), GaveUp> {
     run_condensing(p, law, s, CONDENSE_OPENING)
 }
 
@@ -572,16 +589,23 @@ fn run_condensing(
     law: &dyn CohesiveLaw,
     s: &PathSettings,
     condense_opening: f64,
-) -> Result<(Vec<StepRow>, RunStats), Unfit> {
-    let (d, layout) = prepared(p)?;
-    let mode_one = ModeOne::of(law).ok_or(Unfit::Structure("the law has no elastic domain in mode I"))?;
-    let lin = linear_domain(law, &mode_one).ok_or(Unfit::Structure("the law is not linear near the origin"))?;
+) -> Result<(Vec<StepRow>, RunStats), GaveUp> {
+    let unfit = |why: Unfit| (why, None);
+    let (d, layout) = prepared(p).map_err(unfit)?;
+    let mode_one =
+        ModeOne::of(law).ok_or(Unfit::Structure("the law has no elastic domain in mode I")).map_err(unfit)?;
+    let lin = linear_domain(law, &mode_one)
+        .ok_or(Unfit::Structure("the law is not linear near the origin"))
+        .map_err(unfit)?;
     macro_rules! with {
         ($d:literal) => {{
-            let lay = layout.downcast::<Layout<$d>>().map_err(|_| Unfit::Structure("layout of another node size"))?;
-            let mut solver = Solver::new(p, law, s, lay, lin, mode_one)?;
+            let lay = layout
+                .downcast::<Layout<$d>>()
+                .map_err(|_| Unfit::Structure("layout of another node size"))
+                .map_err(unfit)?;
+            let mut solver = Solver::new(p, law, s, lay, lin, mode_one).map_err(unfit)?;
             solver.condense_opening = condense_opening;
-            solver.run()
+            solver.run().map_err(|why| (why, solver.resume.take()))
         }};
     }
     match d {
@@ -687,6 +711,11 @@ struct Solver<'a, const D: usize> {
     stats: RunStats,
     /// See [`CONDENSE_OPENING`].
     condense_opening: f64,
+    /// Set when the run gives up with a state the whole mesh can go on from.
+    resume: Option<Box<Resume>>,
+    /// Energy dissipated up to the last commit, and by the last step that dissipated (N·mm).
+    dissipated_committed: f64,
+    step_dissipation: f64,
 }
 
 impl<'a, const D: usize> Solver<'a, D> {
@@ -809,6 +838,9 @@ impl<'a, const D: usize> Solver<'a, D> {
             committed_reaction: 0.0,
             stats: RunStats::default(),
             condense_opening: CONDENSE_OPENING,
+            resume: None,
+            dissipated_committed: 0.0,
+            step_dissipation: 0.0,
             lay,
         };
         w.rho = w.lay.kc[0];
@@ -1260,12 +1292,19 @@ impl<'a, const D: usize> Solver<'a, D> {
         }
     }
 
-    fn row(&self, external: f64) -> StepRow {
+    /// Energy the interface has dissipated (N·mm): the points that left the window, and the
+    /// window's.
+    fn dissipated(&self) -> f64 {
         let mut dissipated = self.frozen;
         for j in self.i0..=self.i1 {
             let cp = self.lay.cp(j);
             dissipated += cp.weight * self.pts[cp.point].dissipated(self.law);
         }
+        dissipated
+    }
+
+    fn row(&self, external: f64) -> StepRow {
+        let dissipated = self.dissipated();
         StepRow {
             control: self.c,
             reaction: self.reaction,
@@ -1370,6 +1409,65 @@ impl<'a, const D: usize> Solver<'a, D> {
 
     /// Every point of both regions, recovered from the window: elastic on the right, failed and
     /// open on the left.
+    /// The last committed state as the whole mesh numbers it ([`Resume`]): every unknown, the
+    /// condensed regions' recovered from the window's ends; every point's state (the right
+    /// region's points at their recovered gaps, elastic); the energies and the path's position.
+    /// `None` if the problem cannot be numbered again (it always can: it was at the start).
+    fn resume_state(
+        &self,
+        reason: &'static str,
+        snap_back: bool,
+        rows: Vec<StepRow>,
+        at: Cursor,
+        states: &[LawState],
+    ) -> Option<Box<Resume>> {
+        let (nodes, _, _) = node_dofs(self.p).ok()?;
+        let lay = &self.lay;
+        let mut q = vec![0.0; self.p.mesh.n_dofs()];
+        q[self.p.control] = self.c;
+        let mut put = |j: usize, v: &Vct<D>| {
+            let nd = &nodes[j];
+            for (a, &g) in nd.dofs[..nd.d].iter().enumerate() {
+                q[g] = v[a];
+            }
+        };
+        let mut states = states.to_vec();
+        for j in self.i0..=self.i1 {
+            put(j, &self.q[j]);
+        }
+        let mut prev = self.q[self.i1];
+        for j in self.i1 + 1..=lay.last {
+            let v = self.right_value(j, &prev);
+            put(j, &v);
+            let pi = lay.cp(j).point;
+            states[pi] = self.law.evaluate(&self.gap(j, &v), &states[pi]).state;
+            prev = v;
+        }
+        let mut next = self.q[self.i0];
+        for j in (0..self.i0).rev() {
+            let v = self.left_value(j, &next);
+            put(j, &v);
+            next = v;
+        }
+        let dissipated = self.dissipated();
+        Some(Box::new(Resume {
+            reason,
+            snap_back,
+            q,
+            states,
+            reaction: self.committed_reaction,
+            external_work: at.external,
+            dissipated,
+            dissipation_hint: self.step_dissipation,
+            rows,
+            stats: self.stats,
+            pos: at.pos,
+            h: at.h,
+            k_out: at.k_out,
+            front: at.front,
+        }))
+    }
+
     fn final_check(&self) -> bool {
         let lay = &self.lay;
         let mut prev = self.q[self.i1];
@@ -1476,6 +1574,13 @@ impl<'a, const D: usize> Solver<'a, D> {
                         states[self.lay.cp(j).point] = self.pts[self.lay.cp(j).point].state;
                     }
                     self.committed_reaction = self.reaction;
+                    // The energy the step dissipated: where the window gives up, the whole mesh's
+                    // dissipation constraint starts from it (as it would from its own last step).
+                    let dissipated = self.dissipated();
+                    if dissipated > self.dissipated_committed {
+                        self.step_dissipation = dissipated - self.dissipated_committed;
+                    }
+                    self.dissipated_committed = dissipated;
                     self.stats.steps += 1;
                     let lands = (next - (pos + dh)).abs() <= eps;
                     pos = if lands { next } else { pos + dh };
@@ -1523,7 +1628,10 @@ impl<'a, const D: usize> Solver<'a, D> {
                     self.c = c_old;
                     self.q[i0..=i1].copy_from_slice(&saved_q[i0..=i1]);
                     if self.i1 == self.lay.last && need >= self.i1 {
-                        return Err(Unfit::Run("the window reached the far end"));
+                        let why = "the window reached the far end";
+                        let at = Cursor { pos, h: dh, k_out, external, front };
+                        self.resume = self.resume_state(why, false, std::mem::take(&mut rows), at, &states);
+                        return Err(Unfit::Run(why));
                     }
                     let want = (need.max(self.i1) + 8).min(self.lay.last);
                     while self.i1 < want {
@@ -1541,7 +1649,10 @@ impl<'a, const D: usize> Solver<'a, D> {
                     self.stats.cuts += 1;
                     h = 0.5 * dh;
                     if h < h_min {
-                        return Err(Unfit::Run("no convergence even with the smallest step"));
+                        let why = "no convergence even with the smallest step";
+                        let at = Cursor { pos, h: spacing, k_out, external, front };
+                        self.resume = self.resume_state(why, true, std::mem::take(&mut rows), at, &states);
+                        return Err(Unfit::Run(why));
                     }
                 }
             }
