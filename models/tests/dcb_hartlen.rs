@@ -9,6 +9,19 @@ fn col<'a>(r: &'a Record, c: &str) -> &'a [f64] {
     r.column(c).unwrap()
 }
 
+/// Hartlen's DCB-02 driven to the end of its test (36.9 mm).
+fn dcb02() -> Dcb {
+    let mut d = Dcb::hartlen_dcb01();
+    d.a0 = 33.005;
+    d.control.max_displacement = Some(36.9);
+    d
+}
+
+/// A law with which DCB-02 splits before its test ends (the crack reaches the far end).
+fn splitting_law() -> Bilinear {
+    Bilinear::bk(1e5, 24.38, 1.3 * 24.38, 0.3, 0.6, 2.0).unwrap()
+}
+
 #[test]
 fn hartlen_dcb_reaches_30_mm_with_both_kinematics() {
     let law = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
@@ -54,10 +67,8 @@ fn a_specimen_that_splits_before_the_zone_estimate_says_so_ends_at_the_split() {
     // than the slender-arm estimate of the cohesive zone. The rows after the split (openings and
     // loads falling to zero) describe no test and must not be recorded, nor the run fail there.
     use czid_core::ForwardModel;
-    let mut d = Dcb::hartlen_dcb01();
-    d.a0 = 33.005;
+    let mut d = dcb02();
     d.material.e11 = 32_554.79;
-    d.control.max_displacement = Some(36.9);
     let law = Bilinear::bk(1e5, 9.654621, 31.94808, 0.8162914, 3.485673, 2.0).unwrap();
     let rec = d.simulate(&law).unwrap_or_else(|f| panic!("{}", f.error));
     let (x, p) = (col(&rec, columns::DISPLACEMENT), col(&rec, columns::LOAD));
@@ -74,15 +85,11 @@ fn the_engine_ends_a_split_specimens_run_where_its_arms_spring_back() {
     // the dissipation constraint. The arms spring back to zero load and opening; beyond, the
     // constraint drove the opening below zero (the arms pressed into each other, with growing
     // energy) until nothing converged, and the run failed there, after about twice the time it
-    // took to reach the split. The engine now
-    // ends the run at the first state where the specimen has come apart, the record the model keeps
-    // is the same, and the run succeeds.
+    // took to reach the split. The engine now ends the run at the first state where the specimen
+    // has come apart, the record the model keeps is the same, and the run succeeds.
     use czid_core::ForwardModel;
     use czid_models::fe::run_types::separated;
-    let mut d = Dcb::hartlen_dcb01();
-    d.a0 = 33.005;
-    d.control.max_displacement = Some(36.9);
-    let law = Bilinear::bk(1e5, 24.38, 1.3 * 24.38, 0.3, 0.6, 2.0).unwrap();
+    let (d, law) = (dcb02(), splitting_law());
     let (engine, stats) = dcb::simulate_with_stats(&d, &law).unwrap_or_else(|e| panic!("{e}"));
     println!("{stats:?}");
     assert!(
@@ -112,10 +119,7 @@ fn a_run_the_window_gives_up_on_goes_on_from_its_state_on_the_whole_mesh() {
     // where the arms have sprung back.
     use czid_models::fe::run_types::separated;
     use czid_models::fe::RunOptions;
-    let mut d = Dcb::hartlen_dcb01();
-    d.a0 = 33.005;
-    d.control.max_displacement = Some(36.9);
-    let law = Bilinear::bk(1e5, 24.38, 1.3 * 24.38, 0.3, 0.6, 2.0).unwrap();
+    let (d, law) = (dcb02(), splitting_law());
     let (resumed, stats) = dcb::simulate_with_stats(&d, &law).unwrap_or_else(|e| panic!("{e}"));
     let from_rest = RunOptions { window: false, ..dcb::RUN_OPTIONS };
     let (whole, _) = dcb::simulate_with_options(&d, &law, &from_rest).unwrap_or_else(|e| panic!("{e}"));
