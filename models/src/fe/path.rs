@@ -474,18 +474,11 @@ impl<'a> WholeMesh<'a> {
         if !self.nw.asm.assemble(p, law, &r.states, &r.q, &mut self.nw.k, &mut self.nw.f, false) {
             return;
         }
-        for (i, v) in self.measures.point_stored.iter_mut().enumerate() {
-            let g = &self.nw.asm.gaps[i];
-            *v = match p.points[i].kind {
-                PointKind::Cohesive => law.stored_energy(g, &r.states[i]),
-                PointKind::Contact => super::interface::contact_stored(&self.nw.asm.trial[i], g),
-            };
-        }
-        let stored = self.nw.asm.interface_stored(p, &self.measures.point_stored);
-        let tractions = self.nw.asm.trial.iter().map(|ev| ev.traction).collect();
-        self.ledger = Ledger::resumed(r.external_work, r.dissipated + stored, tractions, self.nw.asm.gaps.to_vec());
         self.prev_q.copy_from_slice(&r.q);
         self.cur = State { q: r.q, states: r.states, reaction: r.reaction };
+        let stored = self.segments_stored(p, law);
+        let tractions = self.nw.asm.trial.iter().map(|ev| ev.traction).collect();
+        self.ledger = Ledger::resumed(r.external_work, r.dissipated + stored, tractions, self.nw.asm.gaps.to_vec());
         self.most_elastic = r.rows.iter().map(|row| row.elastic_energy).fold(0.0, f64::max);
         self.rows = r.rows;
         self.last_diss = r.dissipated;
@@ -504,6 +497,20 @@ impl<'a> WholeMesh<'a> {
             c.tau = self.tau_hint;
             c.last = None;
         }
+    }
+
+    /// The interface's recoverable energy at the last assembly with the committed states,
+    /// integrated along the segments like the forces (the window's resume needs it as well as
+    /// every commit).
+    fn segments_stored(&mut self, p: &FeProblem, law: &dyn CohesiveLaw) -> f64 {
+        for (i, v) in self.measures.point_stored.iter_mut().enumerate() {
+            let g = &self.nw.asm.gaps[i];
+            *v = match p.points[i].kind {
+                PointKind::Cohesive => law.stored_energy(g, &self.cur.states[i]),
+                PointKind::Contact => super::interface::contact_stored(&self.nw.asm.trial[i], g),
+            };
+        }
+        self.nw.asm.interface_stored(p, &self.measures.point_stored)
     }
 
     /// The run's failure with every row recorded so far.
@@ -737,18 +744,7 @@ impl<'a> WholeMesh<'a> {
         self.cur.reaction = reaction;
         // With segments the recoverable energy is integrated like the forces (the dissipation
         // stays point by point, where the work is integrated).
-        let stored = if self.segments {
-            for (i, v) in self.measures.point_stored.iter_mut().enumerate() {
-                let g = &self.nw.asm.gaps[i];
-                *v = match p.points[i].kind {
-                    PointKind::Cohesive => law.stored_energy(g, &self.cur.states[i]),
-                    PointKind::Contact => super::interface::contact_stored(&self.nw.asm.trial[i], g),
-                };
-            }
-            self.nw.asm.interface_stored(p, &self.measures.point_stored)
-        } else {
-            stored
-        };
+        let stored = if self.segments { self.segments_stored(p, law) } else { stored };
         if dissipated - self.last_diss > 0.0 {
             self.tau_hint = dissipated - self.last_diss;
         }

@@ -1303,8 +1303,8 @@ impl<'a, const D: usize> Solver<'a, D> {
         dissipated
     }
 
-    fn row(&self, external: f64) -> StepRow {
-        let dissipated = self.dissipated();
+    /// The committed state's row, with `dissipated` from [`Solver::dissipated`].
+    fn row(&self, external: f64, dissipated: f64) -> StepRow {
         StepRow {
             control: self.c,
             reaction: self.reaction,
@@ -1407,8 +1407,6 @@ impl<'a, const D: usize> Solver<'a, D> {
         true
     }
 
-    /// Every point of both regions, recovered from the window: elastic on the right, failed and
-    /// open on the left.
     /// The last committed state as the whole mesh numbers it ([`Resume`]): every unknown, the
     /// condensed regions' recovered from the window's ends; every point's state (the right
     /// region's points at their recovered gaps, elastic); the energies and the path's position.
@@ -1435,20 +1433,14 @@ impl<'a, const D: usize> Solver<'a, D> {
         for j in self.i0..=self.i1 {
             put(j, &self.q[j]);
         }
-        let mut prev = self.q[self.i1];
-        for j in self.i1 + 1..=lay.last {
-            let v = self.right_value(j, &prev);
-            put(j, &v);
-            let pi = lay.cp(j).point;
-            states[pi] = self.law.evaluate(&self.gap(j, &v), &states[pi]).state;
-            prev = v;
-        }
-        let mut next = self.q[self.i0];
-        for j in (0..self.i0).rev() {
-            let v = self.left_value(j, &next);
-            put(j, &v);
-            next = v;
-        }
+        self.walk_condensed(0, |j, v| {
+            put(j, v);
+            if j > self.i1 {
+                let pi = lay.cp(j).point;
+                states[pi] = self.law.evaluate(&self.gap(j, v), &states[pi]).state;
+            }
+            true
+        });
         let dissipated = self.dissipated();
         Some(Box::new(Resume {
             reason,
@@ -1468,26 +1460,39 @@ impl<'a, const D: usize> Solver<'a, D> {
         }))
     }
 
-    fn final_check(&self) -> bool {
-        let lay = &self.lay;
+    /// Recovers the condensed regions' unknowns from the window's ends and visits each node with
+    /// them: the right region's from the window outwards, then the left region's down to node
+    /// `left_to`; stops at the first visit that returns `false` (and returns `false`).
+    fn walk_condensed(&self, left_to: usize, mut visit: impl FnMut(usize, &Vct<D>) -> bool) -> bool {
         let mut prev = self.q[self.i1];
-        for j in self.i1 + 1..=lay.last {
+        for j in self.i1 + 1..=self.lay.last {
             let v = self.right_value(j, &prev);
-            if !self.lin.contains(&self.gap(j, &v)) {
+            if !visit(j, &v) {
                 return false;
             }
             prev = v;
         }
         let mut next = self.q[self.i0];
-        for j in (lay.first..self.i0).rev() {
+        for j in (left_to..self.i0).rev() {
             let v = self.left_value(j, &next);
-            let pi = lay.cp(j).point;
-            if self.gap(j, &v)[0] < 0.0 || self.pts[pi].state.damage < 1.0 {
+            if !visit(j, &v) {
                 return false;
             }
             next = v;
         }
         true
+    }
+
+    /// Every point of both regions, recovered from the window: elastic on the right, failed and
+    /// open on the left.
+    fn final_check(&self) -> bool {
+        self.walk_condensed(self.lay.first, |j, v| {
+            if j > self.i1 {
+                self.lin.contains(&self.gap(j, v))
+            } else {
+                self.gap(j, v)[0] >= 0.0 && self.pts[self.lay.cp(j).point].state.damage >= 1.0
+            }
+        })
     }
 
     fn run(&mut self) -> Result<(Vec<StepRow>, RunStats), Unfit> {
@@ -1597,7 +1602,7 @@ impl<'a, const D: usize> Solver<'a, D> {
                         &self.fronts[k0..i1 - self.lay.first],
                     );
                     if lands {
-                        rows.push(self.row(external));
+                        rows.push(self.row(external, dissipated));
                     }
                     // Window for the next step.
                     need_node = need;
