@@ -121,12 +121,16 @@ impl Bilinear {
         let onset_n2 = (self.strength_n / self.penalty).powi(2);
         let onset_s2 = (self.strength_t / self.penalty).powi(2);
         let onset = (complement * (1.0 / onset_n2) + mixity * (1.0 / onset_s2)).sqrt().recip();
+        if effective.v <= onset.v {
+            // Inside the elastic envelope: no damage growth, and no need for the mixed-mode
+            // toughness (the B-K power is the costliest part of an evaluation).
+            let (t, k) = secant(stiffness, 1.0 - damage_old, gap);
+            return (t, k, damage_old);
+        }
         let final_opening = self.toughness(mixity, complement) * (2.0 / self.penalty) / onset;
         // The intact fraction 1 − D = δ_0 (δ_f − δ) / (δ (δ_f − δ_0)), computed as such so that the
         // traction keeps its digits as D → 1.
-        let intact = if effective.v <= onset.v {
-            Dual::constant(1.0)
-        } else if effective.v >= final_opening.v || final_opening.v <= onset.v {
+        let intact = if effective.v >= final_opening.v || final_opening.v <= onset.v {
             // Beyond the final separation (or a law too stiff to soften there): fully separated.
             Dual::constant(0.0)
         } else {
