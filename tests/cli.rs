@@ -208,6 +208,8 @@ fn without_a_terminal_identify_prints_progress_lines_for_the_log() {
     let count = |l: &str| l["progress: ".len()..].split('/').next().unwrap().parse::<usize>().unwrap();
     let counts: Vec<usize> = lines.iter().map(|l| count(l)).collect();
     assert!(counts.windows(2).all(|w| w[0] < w[1]) && counts[counts.len() - 1] <= 120, "{lines:?}");
+    // While the run goes on, each line says when the budget will be used up at its pace.
+    assert!(lines[..lines.len() - 1].iter().all(|l| l.contains(", budget used up in about ")), "{lines:?}");
     let log = std::fs::read_to_string(out.join("history.csv")).unwrap();
     let evaluations: usize = log.lines().last().unwrap().split(',').nth(1).unwrap().parse().unwrap();
     assert_eq!(counts[counts.len() - 1], evaluations, "{lines:?}");

@@ -22,6 +22,17 @@ impl Observer for Observers<'_> {
     }
 }
 
+/// `seconds` for a person reading a log: tenths of a second below ten, minutes from two on.
+fn about(seconds: f64) -> String {
+    if seconds < 10.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 120.0 {
+        format!("{seconds:.0} s")
+    } else {
+        format!("{:.0} min", seconds / 60.0)
+    }
+}
+
 /// A terminal progress bar over the evaluation budget, showing the best value.
 pub struct ProgressBar {
     bar: indicatif::ProgressBar,
@@ -40,23 +51,32 @@ struct LogLines {
 }
 
 impl LogLines {
-    fn print(&self, total: u64, evaluations: usize, best: f64, failures: usize) {
+    /// Prints a line; `pace` adds when the budget will be used up at the pace so far (a run
+    /// still going; a method that converges stops earlier, so it is the most the run can take).
+    fn print(&self, total: u64, evaluations: usize, best: f64, failures: usize, pace: bool) {
+        let elapsed = self.start.elapsed().as_secs_f64();
+        let left = (total as f64 - evaluations as f64).max(0.0) * elapsed / evaluations.max(1) as f64;
+        let pace = if pace && evaluations > 0 && left > 0.0 {
+            format!(", budget used up in about {}", about(left))
+        } else {
+            String::new()
+        };
         eprintln!(
-            "progress: {evaluations}/{total} evaluations, best {best:.6e}, {failures} failed, {:.1} s",
-            self.start.elapsed().as_secs_f64()
+            "progress: {evaluations}/{total} evaluations, best {best:.6e}, {failures} failed, {elapsed:.1} s{pace}"
         );
     }
 }
 
 impl ProgressBar {
-    /// A bar for a budget of `evaluations`. When standard error is not a terminal (a batch job's
-    /// log) no bar can be drawn; a plain line is printed instead at every tenth of the budget.
+    /// A bar for a budget of `evaluations`, with when the budget will be used up at the pace so
+    /// far. When standard error is not a terminal (a batch job's log) no bar can be drawn; a plain
+    /// line is printed instead at every tenth of the budget.
     pub fn new(evaluations: usize) -> Self {
         use std::io::IsTerminal;
         let bar = indicatif::ProgressBar::new(evaluations as u64);
-        if let Ok(style) =
-            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} evals  {msg}")
-        {
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} evals, budget used up in {eta}  {msg}",
+        ) {
             bar.set_style(style.progress_chars("=> "));
         }
         let every = evaluations.div_ceil(10).max(1);
@@ -86,7 +106,7 @@ impl ProgressBar {
         let total = self.bar.length().unwrap_or(0);
         if let Some(l) = &mut self.lines {
             if let Some((evaluations, best, failures)) = l.unprinted.take() {
-                l.print(total, evaluations, best, failures);
+                l.print(total, evaluations, best, failures, false);
             }
         }
     }
@@ -104,7 +124,7 @@ impl Observer for ProgressBar {
         if let Some(l) = &mut self.lines {
             l.unprinted = Some((p.evaluations, p.best_value, p.failures));
             if p.evaluations >= l.next {
-                l.print(self.bar.length().unwrap_or(0), p.evaluations, p.best_value, p.failures);
+                l.print(self.bar.length().unwrap_or(0), p.evaluations, p.best_value, p.failures, true);
                 l.next = (p.evaluations / l.every + 1) * l.every;
                 l.unprinted = None;
             }
