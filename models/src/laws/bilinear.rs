@@ -111,9 +111,13 @@ impl Bilinear {
         let s = Dual::new(gap.y, [0.0, 1.0]);
         let (m2, s2) = (m * m, s * s);
         let effective2 = m2 + s2;
-        if damage_old >= 1.0 || effective2.v == 0.0 {
+        // No damage growth: the secant of the committed damage.
+        let unchanged = || {
             let (t, k) = secant(stiffness, 1.0 - damage_old, gap);
-            return (t, k, damage_old);
+            (t, k, damage_old)
+        };
+        if damage_old >= 1.0 || effective2.v == 0.0 {
+            return unchanged();
         }
         let effective = effective2.sqrt();
         let mixity = s2 / effective2;
@@ -122,10 +126,9 @@ impl Bilinear {
         let onset_s2 = (self.strength_t / self.penalty).powi(2);
         let onset = (complement * (1.0 / onset_n2) + mixity * (1.0 / onset_s2)).sqrt().recip();
         if effective.v <= onset.v {
-            // Inside the elastic envelope: no damage growth, and no need for the mixed-mode
-            // toughness (the B-K power is the costliest part of an evaluation).
-            let (t, k) = secant(stiffness, 1.0 - damage_old, gap);
-            return (t, k, damage_old);
+            // Inside the elastic envelope, before the mixed-mode toughness is worked out (the B-K
+            // power is the costliest part of an evaluation).
+            return unchanged();
         }
         let final_opening = self.toughness(mixity, complement) * (2.0 / self.penalty) / onset;
         // The intact fraction 1 − D = δ_0 (δ_f − δ) / (δ (δ_f − δ_0)), computed as such so that the
@@ -138,8 +141,7 @@ impl Bilinear {
         };
         let damage = 1.0 - intact.v;
         if damage <= damage_old {
-            let (t, k) = secant(stiffness, 1.0 - damage_old, gap);
-            return (t, k, damage_old);
+            return unchanged();
         }
         let (t, mut k) = secant(stiffness, intact.v, gap);
         add_damage_growth(&mut k, stiffness, gap, [-intact.g[0], -intact.g[1]]);
