@@ -323,14 +323,18 @@ impl ExperimentSpec {
                     dropped.non_finite += 1;
                 }
                 Err(e) => {
-                    return Err(if missing_or_non_finite(&record, &[Some(ix), Some(iy), ic]) {
-                        CzError::data(
-                            format!("{shown}, row {row}"),
-                            format!("{e}; set `drop_non_finite = true` to drop such rows"),
-                        )
-                    } else {
-                        e
-                    })
+                    return Err(match e {
+                        // The cell's own error already says where; add the way out.
+                        CzError::Data { location, message }
+                            if missing_or_non_finite(&record, &[Some(ix), Some(iy), ic]) =>
+                        {
+                            CzError::data(
+                                location,
+                                format!("{message}; set `drop_non_finite = true` to drop such rows"),
+                            )
+                        }
+                        e => e,
+                    });
                 }
             }
         }
@@ -573,7 +577,8 @@ mod tests {
         let dir = write("nan-rows", text);
         // By default the first such row is an error that says how to drop them.
         let e = spec("t.csv").load(dir.path()).unwrap_err().to_string();
-        assert!(e.contains("row 3") && e.contains("drop_non_finite"), "{e}");
+        assert!(e.contains("row 3, column `Force`") && e.contains("drop_non_finite"), "{e}");
+        assert_eq!(e.matches("row 3").count(), 1, "the place is said once: {e}");
         let mut s = spec("t.csv");
         s.drop_non_finite = true;
         let e = s.load(dir.path()).unwrap();
