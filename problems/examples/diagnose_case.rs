@@ -5,7 +5,7 @@
 //! cargo run --release -p czid-problems --example diagnose_case -- \
 //!     --truth continuum --cases 4 --nulls 6 --seed 31 \
 //!     --effects fibre_bridging,machine_compliance,seating_toe,load_offset,crack_length_offset,displacement_gain \
-//!     --case 21 [--out summary.json]
+//!     --case 21 [--out summary.json] [--refit large_rotation]
 //! cargo run --release -p czid-problems --example diagnose_case -- \
 //!     --family beam --truth beam --cases 20 --nulls 20 --seed 7 --case 2
 //! ```
@@ -44,6 +44,11 @@ fn main() {
     let last = Mutex::new((Instant::now(), String::from("start"), tally::snapshot()));
     let diagnosing = Instant::now();
     let mut options = prepared.options;
+    // Candidates to refit whatever their score (on request: they take no part in the verdict), e.g.
+    // to measure what a candidate removes from clean tests.
+    if let Some(names) = arg("--refit") {
+        options.always_refit.extend(names.split(',').map(String::from));
+    }
     options.progress = Some(Box::new(move |m: &str| {
         let mut l = last.lock().unwrap();
         let now = tally::snapshot();

@@ -163,6 +163,9 @@ pub struct Refit {
     pub parameters: Vec<Value>,
     /// Effect parameters.
     pub effect: Vec<Value>,
+    /// The effect is a switch (large rotations: on or off), so the refit has no size of the
+    /// effect to fit, only the fitted parameters.
+    pub switch: bool,
     /// χ² (noise units).
     pub chi2: f64,
     /// Realised shrinkage `1 − χ²/χ²_base`.

@@ -247,6 +247,7 @@ pub fn report(base: &Base, regs: &[Regime], entry: &Ranked, out: &RefitOutcome) 
     Refit {
         parameters: space.parameters().iter().zip(&xv).map(|(q, &v)| value(q, v)).collect(),
         effect: params.iter().zip(&out.v[p..]).map(|(q, &w)| value(q, q.from_unit(w))).collect(),
+        switch: c.discrete(),
         chi2: chi,
         shrinkage: 1.0 - chi / base.chi2.max(f64::MIN_POSITIVE),
         by_regime,
