@@ -120,6 +120,15 @@ pub trait CohesiveLaw: Send + Sync + std::fmt::Debug {
         0
     }
 
+    /// Whether the traction along a pure opening path (zero slip), on the loading envelope, is
+    /// linear between the kinks the integrators place breakpoints at (damage onset, the inner
+    /// kinks, complete failure), as for linear softening (default `false`). The work done on a
+    /// point over a step is then integrated by the trapezoidal rule on each piece, which is exact
+    /// there, instead of sampling the law between the kinks.
+    fn opening_path_piecewise_linear(&self) -> bool {
+        false
+    }
+
     /// Whether `state` lies beyond inner kink `k` (`k <` [`CohesiveLaw::inner_kinks`]) along its
     /// loading path: `false` before it, `true` from it on, never back.
     fn beyond_inner_kink(&self, state: &LawState, k: usize) -> bool {

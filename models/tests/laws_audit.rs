@@ -50,6 +50,54 @@ fn audit_passes_for_every_bundled_law() {
     }
 }
 
+#[test]
+fn the_laws_that_say_their_opening_path_is_piecewise_linear_are() {
+    for law in bundled() {
+        let claim = law.opening_path_piecewise_linear();
+        let nonlinearity = verify::opening_path_nonlinearity(law.as_ref());
+        assert_eq!(nonlinearity.is_some(), claim, "{law:?}");
+        if let Some(e) = nonlinearity {
+            assert!(e < 1e-12, "{law:?}: second differences {e:e} of the strength");
+        }
+    }
+    // The sawtooth ST-CZM and the bilinear law say so; curved softening does not.
+    let says = |law: &dyn CohesiveLaw| law.opening_path_piecewise_linear();
+    assert!(says(&StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273).unwrap()));
+    assert!(says(&Bilinear::bk(1e5, 30.0, 45.0, 0.28, 0.9, 2.1).unwrap()));
+    assert!(!says(&Exponential::new(30.0, 0.001, 40.0, 0.002).unwrap()));
+}
+
+/// An ST-CZM with exponential softening that wrongly says its opening path is piecewise linear.
+#[derive(Debug, Serialize, Deserialize)]
+struct CurvedClaimingLinear {
+    inner: StCzm,
+}
+
+#[typetag::serde(name = "test_curved_claiming_linear")]
+impl CohesiveLaw for CurvedClaimingLinear {
+    fn validate(&self) -> Result<()> {
+        self.inner.validate()
+    }
+    fn evaluate(&self, gap: &Gap, previous: &LawState) -> LawEval {
+        self.inner.evaluate(gap, previous)
+    }
+    fn fracture_energy(&self) -> [f64; 2] {
+        self.inner.fracture_energy()
+    }
+    fn initial_stiffness(&self) -> [f64; 2] {
+        self.inner.initial_stiffness()
+    }
+    fn strength(&self) -> [f64; 2] {
+        self.inner.strength()
+    }
+    fn parameters(&self) -> Vec<ParameterInfo> {
+        self.inner.parameters()
+    }
+    fn opening_path_piecewise_linear(&self) -> bool {
+        true
+    }
+}
+
 /// A bilinear law with one defect switched on.
 #[derive(Debug, Serialize, Deserialize)]
 struct Broken {
@@ -110,4 +158,13 @@ fn audit_catches_each_defect() {
     let heals = verify::audit(&Broken { inner: inner(), defect: Defect::Heals });
     assert!(!heals.passed(1e-6) && !heals.damage_admissible, "{heals:?}");
     assert!(heals.min_dissipation < -1e-5, "{heals:?}");
+    // A false claim of a piecewise-linear opening path (the energy integration would skip the
+    // law's curvature between kinks).
+    let curved = StCzm::sawtooth(27.0, 0.00027, 0.003273, 40.0, 0.00025, 0.003273)
+        .unwrap()
+        .with_shapes(StrengthShape::Exponential { alpha: 2.5 }, StrengthShape::Sawtooth)
+        .unwrap();
+    let claim = verify::audit(&CurvedClaimingLinear { inner: curved });
+    assert!(!claim.passed(1e-6), "{claim:?}");
+    assert!(claim.opening_nonlinearity.unwrap() > 1e-8, "{claim:?}");
 }

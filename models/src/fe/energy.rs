@@ -182,6 +182,9 @@ pub(crate) fn path_work_split(
     }
     bp[n] = 1.0;
     bp[1..n].sort_by(f64::total_cmp);
+    // Linear pieces need no sample between their ends: Simpson's rule with the mean of the ends
+    // for the midpoint is the trapezoidal rule, exact on them.
+    let linear = pure && law.opening_path_piecewise_linear();
     let (mut w, mut ws) = (0.0, 0.0);
     // The traction at the end of a piece is the next piece's start (evaluated once).
     let mut carried: Option<(f64, Traction)> = None;
@@ -197,7 +200,7 @@ pub(crate) fn path_work_split(
         };
         let tb = if b == 1.0 { t1 } else { traction(b) };
         carried = Some((b, tb));
-        let tm = traction(0.5 * (a + b));
+        let tm = if linear { (ta + tb) * 0.5 } else { traction(0.5 * (a + b)) };
         let simpson = ta + tm * 4.0 + tb;
         w += (b - a) / 6.0 * simpson.dot(&dg);
         ws += (b - a) / 6.0 * simpson[1] * dg[1];

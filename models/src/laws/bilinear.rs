@@ -208,6 +208,11 @@ impl CohesiveLaw for Bilinear {
         [self.penalty, self.penalty]
     }
 
+    /// Linear softening: `T = K δ₀ (δ_f − δ)/(δ_f − δ₀)` between onset and failure.
+    fn opening_path_piecewise_linear(&self) -> bool {
+        true
+    }
+
     fn strength(&self) -> [f64; 2] {
         [self.strength_n, self.strength_t]
     }

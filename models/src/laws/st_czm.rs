@@ -206,6 +206,12 @@ impl CohesiveLaw for StCzm {
         self.stiffness()
     }
 
+    /// The sawtooth's opening on its strength surface, `δ = u_e/(p + c I)`, makes the traction
+    /// `K I δ = K (u_e − p δ)/c` linear in the opening; the exponential shape's is not.
+    fn opening_path_piecewise_linear(&self) -> bool {
+        self.shape_n == StrengthShape::Sawtooth
+    }
+
     fn strength(&self) -> [f64; 2] {
         [self.strength_n, self.strength_t]
     }

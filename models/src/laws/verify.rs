@@ -6,6 +6,8 @@
 //!   integrate the work `∫ T·du`;
 //! * [`pure_mode_energy`]: the energy to separate in a pure mode against
 //!   [`CohesiveLaw::fracture_energy`];
+//! * [`opening_path_nonlinearity`]: a law's claim that its opening path is linear between kinks
+//!   ([`CohesiveLaw::opening_path_piecewise_linear`]) against its traction;
 //! * [`audit`]: all of these (and irreversibility) on a standard set of paths scaled to the law.
 //!
 //! ```
@@ -272,6 +274,31 @@ pub fn separation_opening(law: &dyn CohesiveLaw, mode: Mode) -> Option<f64> {
     None
 }
 
+/// For a law that says its monotonic pure opening path is linear between kinks
+/// ([`CohesiveLaw::opening_path_piecewise_linear`]): the largest second difference of the normal
+/// traction over three evenly spaced openings of the same piece (elastic, softening between the
+/// same inner kinks, failed), relative to the normal strength, on 3000 steps to 1.2 times the
+/// separation opening. Zero to round-off (~10⁻¹⁵) when the claim holds; a curved softening
+/// (exponential) gives 10⁻⁸ or more. `None` for a law that makes no such claim or never separates.
+pub fn opening_path_nonlinearity(law: &dyn CohesiveLaw) -> Option<f64> {
+    if !law.opening_path_piecewise_linear() {
+        return None;
+    }
+    let sep = separation_opening(law, Mode::Normal)?;
+    let points = follow_path(law, &line(Gap::zeros(), Mode::Normal.gap(1.2 * sep), 3000));
+    let piece = |p: &PathPoint| {
+        let kinks = (0..law.inner_kinks()).filter(|&k| law.beyond_inner_kink(&p.state, k)).count();
+        (p.state.damage > 0.0, p.state.damage >= 1.0, kinks)
+    };
+    let strength = law.strength()[0];
+    let worst = points
+        .windows(3)
+        .filter(|w| piece(&w[0]) == piece(&w[1]) && piece(&w[1]) == piece(&w[2]))
+        .map(|w| (w[0].traction[0] - 2.0 * w[1].traction[0] + w[2].traction[0]).abs() / strength)
+        .fold(0.0f64, f64::max);
+    Some(worst)
+}
+
 /// The worst tangent check along a path (each point checked from the previous committed state),
 /// and how many points were skipped because they sit on a kink.
 pub fn worst_tangent_along(law: &dyn CohesiveLaw, path: &[Gap]) -> (Option<TangentCheck>, usize) {
@@ -309,14 +336,18 @@ pub struct Audit {
     pub min_dissipation: f64,
     /// Every traction was finite.
     pub finite: bool,
+    /// [`opening_path_nonlinearity`] (`None`: the law makes no linearity claim).
+    pub opening_nonlinearity: Option<f64>,
 }
 
 impl Audit {
     /// Whether tangent and energy errors are within `tolerance`, damage is admissible, no energy
-    /// is created (beyond `tolerance`) and fewer than 5 % of points were kinks.
+    /// is created (beyond `tolerance`), fewer than 5 % of points were kinks, and a claimed
+    /// piecewise-linear opening path is linear to round-off (10⁻¹⁰ of the strength).
     pub fn passed(&self, tolerance: f64) -> bool {
         let energy_ok = self.energy.iter().all(|e| e.is_some_and(|e| e.relative_error <= tolerance));
-        self.finite
+        self.opening_nonlinearity.is_none_or(|e| e <= 1e-10)
+            && self.finite
             && self.damage_admissible
             && self.tangent_error <= tolerance
             && energy_ok
@@ -374,6 +405,7 @@ pub fn audit(law: &dyn CohesiveLaw) -> Audit {
         damage_admissible: true,
         min_dissipation: f64::INFINITY,
         finite: true,
+        opening_nonlinearity: opening_path_nonlinearity(law),
     };
     let toughness = law.fracture_energy();
     let energy_scale = toughness[0].min(toughness[1]);
