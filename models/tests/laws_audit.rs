@@ -67,41 +67,10 @@ fn the_laws_that_say_their_opening_path_is_piecewise_linear_are() {
     assert!(!says(&Exponential::new(30.0, 0.001, 40.0, 0.002).unwrap()));
 }
 
-/// An ST-CZM with exponential softening that wrongly says its opening path is piecewise linear.
-#[derive(Debug, Serialize, Deserialize)]
-struct CurvedClaimingLinear {
-    inner: StCzm,
-}
-
-#[typetag::serde(name = "test_curved_claiming_linear")]
-impl CohesiveLaw for CurvedClaimingLinear {
-    fn validate(&self) -> Result<()> {
-        self.inner.validate()
-    }
-    fn evaluate(&self, gap: &Gap, previous: &LawState) -> LawEval {
-        self.inner.evaluate(gap, previous)
-    }
-    fn fracture_energy(&self) -> [f64; 2] {
-        self.inner.fracture_energy()
-    }
-    fn initial_stiffness(&self) -> [f64; 2] {
-        self.inner.initial_stiffness()
-    }
-    fn strength(&self) -> [f64; 2] {
-        self.inner.strength()
-    }
-    fn parameters(&self) -> Vec<ParameterInfo> {
-        self.inner.parameters()
-    }
-    fn opening_path_piecewise_linear(&self) -> bool {
-        true
-    }
-}
-
-/// A bilinear law with one defect switched on.
+/// A law with one defect switched on.
 #[derive(Debug, Serialize, Deserialize)]
 struct Broken {
-    inner: Bilinear,
+    inner: Box<dyn CohesiveLaw>,
     defect: Defect,
 }
 
@@ -113,6 +82,8 @@ enum Defect {
     WrongEnergy,
     /// Heals: damage follows the current gap instead of its maximum.
     Heals,
+    /// Says its opening path is linear between kinks when it is not.
+    ClaimsLinearOpening,
 }
 
 #[typetag::serde(name = "test_broken")]
@@ -145,11 +116,14 @@ impl CohesiveLaw for Broken {
     fn parameters(&self) -> Vec<ParameterInfo> {
         self.inner.parameters()
     }
+    fn opening_path_piecewise_linear(&self) -> bool {
+        self.defect == Defect::ClaimsLinearOpening || self.inner.opening_path_piecewise_linear()
+    }
 }
 
 #[test]
 fn audit_catches_each_defect() {
-    let inner = || Bilinear::bk(1e5, 30.0, 45.0, 0.28, 0.9, 2.1).unwrap();
+    let inner = || Box::new(Bilinear::bk(1e5, 30.0, 45.0, 0.28, 0.9, 2.1).unwrap()) as Box<dyn CohesiveLaw>;
     let tangent = verify::audit(&Broken { inner: inner(), defect: Defect::SecantTangent });
     assert!(!tangent.passed(1e-6) && tangent.tangent_error > 1e-2, "{tangent:?}");
     let energy = verify::audit(&Broken { inner: inner(), defect: Defect::WrongEnergy });
@@ -164,7 +138,7 @@ fn audit_catches_each_defect() {
         .unwrap()
         .with_shapes(StrengthShape::Exponential { alpha: 2.5 }, StrengthShape::Sawtooth)
         .unwrap();
-    let claim = verify::audit(&CurvedClaimingLinear { inner: curved });
+    let claim = verify::audit(&Broken { inner: Box::new(curved), defect: Defect::ClaimsLinearOpening });
     assert!(!claim.passed(1e-6), "{claim:?}");
     assert!(claim.opening_nonlinearity.unwrap() > 1e-8, "{claim:?}");
 }
