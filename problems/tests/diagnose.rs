@@ -146,6 +146,21 @@ fn diagnose_synthetic(bridging: f64) -> czid_problems::diagnose::Diagnosis {
 /// through each arm). A beam-made test has no model-form misfit: it is diagnosed without the
 /// model-form floor, which would otherwise add the continuum's difference to it.
 fn diagnose_made_by(bridging: f64, continuum: bool) -> czid_problems::diagnose::Diagnosis {
+    let (subject, u0) = synthetic_subject(bridging, continuum);
+    let opts = Options {
+        candidates: ["machine_compliance", "fibre_bridging", "crack_length_offset", "displacement_offset"]
+            .map(String::from)
+            .to_vec(),
+        refit: 1,
+        holdout: false,
+        model_form: continuum,
+        ..Options::default()
+    };
+    diagnose_subject(&subject, &u0, &Library::builtin(), &opts).unwrap()
+}
+
+/// The test of [`diagnose_made_by`] and the base fit's start (near the truth, not at it).
+fn synthetic_subject(bridging: f64, continuum: bool) -> (Subject, Vec<f64>) {
     let base = dcb_setup(16.0, 60);
     let library = Library::builtin();
     let truth = if bridging > 0.0 {
@@ -179,16 +194,19 @@ fn diagnose_made_by(bridging: f64, continuum: bool) -> czid_problems::diagnose::
         space.to_unit(&[30.0, 0.8, 19_300.0]).iter().zip([0.05, -0.05, 0.05]).map(|(u, d)| u + d).collect();
     let subject =
         Subject { name: "synthetic".into(), setup: base, space, experiments: vec![experiment], use_length: true };
+    (subject, u0)
+}
+
+#[test]
+fn a_refit_asked_for_by_a_name_that_is_not_a_candidate_is_an_error() {
+    let (subject, u0) = synthetic_subject(0.0, false);
     let opts = Options {
-        candidates: ["machine_compliance", "fibre_bridging", "crack_length_offset", "displacement_offset"]
-            .map(String::from)
-            .to_vec(),
-        refit: 1,
-        holdout: false,
-        model_form: continuum,
+        candidates: vec!["machine_compliance".into()],
+        always_refit: vec!["machine_complaince".into()],
         ..Options::default()
     };
-    diagnose_subject(&subject, &u0, &library, &opts).unwrap()
+    let err = diagnose_subject(&subject, &u0, &Library::builtin(), &opts).err().unwrap().to_string();
+    assert!(err.contains("`machine_complaince` is not among") && err.contains("machine_compliance"), "{err}");
 }
 
 #[test]

@@ -44,7 +44,8 @@ pub struct Options {
     /// Also check transfer to the held-out last regime of each curve (the late stage; a beam's
     /// debonding, [`czid_core::RegimeRule::held_out`]).
     pub holdout: bool,
-    /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case).
+    /// Candidates refitted whatever their score (e.g. the planted effect of a benchmark case); a
+    /// name that is not among the diagnosis's candidates is an error.
     pub always_refit: Vec<String>,
     /// Account for the model-form misfit with the models' reference models
     /// ([`super::stages::model_form`]) before judging any candidate.
@@ -389,6 +390,17 @@ pub fn diagnose_subject(subject: &Subject, u0: &[f64], library: &Library, opts: 
         }
     };
     let chosen = library.select(&subject.setup, &opts.candidates)?;
+    // A refit asked for by name must not be dropped in silence (a misspelt name would be).
+    if let Some(n) = opts.always_refit.iter().find(|n| !chosen.iter().any(|c| c.name() == n.as_str())) {
+        let known: Vec<&str> = chosen.iter().map(|c| c.name()).collect();
+        return Err(CzError::config(
+            "always_refit",
+            format!(
+                "`{n}` is not among this diagnosis's candidates, so it cannot be refitted; they are: {}",
+                known.join(", ")
+            ),
+        ));
+    }
     let gauge = Gauge::new(&subject.experiments, subject.use_length, opts.noise)?;
     let measured = gauge.clone();
     say("polishing the base fit on the misfit in noise units");
