@@ -154,23 +154,26 @@ pub(crate) fn path_work_split(
     let dg = g1 - g0;
     let at = |t: f64| g0 + dg * t;
     let traction = |t: f64| law.evaluate(&at(t), s0).traction;
-    // Breakpoints: where damage starts (from a virgin state) and where it completes.
-    let mut bp = [1.0; 4 + super::segment::MAX_INNER_KINKS];
-    bp[0] = 0.0;
+    // Breakpoints: where damage starts (from a virgin state) and where it completes; each with
+    // its traction where that is known without the law. A pure opening path crosses them at the
+    // openings of `mode_one`, which holds the tractions there (the law is continuous at them).
+    let mut bp: [Breakpoint; 4 + super::segment::MAX_INNER_KINKS] = [(1.0, None); _];
+    bp[0] = (0.0, Some(t0));
     let mut n = 1;
     let pure = g0[1] == 0.0 && g1[1] == 0.0;
+    let exact = if pure { mode_one } else { None };
     let openings = (g0[0], g1[0]);
     if s0.damage <= 0.0 && after.damage > 0.0 {
         let onset = mode_one.map(|m| m.onset);
         if let Some(t) = split(pure, openings, onset, &|t| law.evaluate(&at(t), s0).state.damage > 0.0) {
-            bp[n] = t;
+            bp[n] = (t, exact.map(|m| m.onset_traction));
             n += 1;
         }
     }
     if s0.damage < 1.0 && after.damage >= 1.0 {
         let failure = mode_one.and_then(|m| m.failure);
         if let Some(t) = split(pure, openings, failure, &|t| law.evaluate(&at(t), s0).state.damage >= 1.0) {
-            bp[n] = t;
+            bp[n] = (t, exact.filter(|m| m.failure.is_some()).map(|m| m.failure_traction));
             n += 1;
         }
     }
@@ -180,8 +183,8 @@ pub(crate) fn path_work_split(
     if inner_count > 0 {
         n = inner_kink_breakpoints(law, s0, after, (g0, g1), mode_one, inner_count, &mut bp, n);
     }
-    bp[n] = 1.0;
-    bp[1..n].sort_by(f64::total_cmp);
+    bp[n] = (1.0, Some(t1));
+    bp[1..n].sort_by(|x, y| x.0.total_cmp(&y.0));
     // Linear pieces need no sample between their ends: Simpson's rule with the mean of the ends
     // for the midpoint is the trapezoidal rule, exact on them.
     let linear = pure && law.opening_path_piecewise_linear();
@@ -189,16 +192,15 @@ pub(crate) fn path_work_split(
     // The traction at the end of a piece is the next piece's start (evaluated once).
     let mut carried: Option<(f64, Traction)> = None;
     for k in 0..n {
-        let (a, b) = (bp[k], bp[k + 1]);
+        let ((a, known_a), (b, known_b)) = (bp[k], bp[k + 1]);
         if b <= a {
             continue;
         }
         let ta = match carried {
             Some((at, t)) if at == a => t,
-            _ if a == 0.0 => t0,
-            _ => traction(a),
+            _ => known_a.unwrap_or_else(|| traction(a)),
         };
-        let tb = if b == 1.0 { t1 } else { traction(b) };
+        let tb = known_b.unwrap_or_else(|| traction(b));
         carried = Some((b, tb));
         let tm = if linear { (ta + tb) * 0.5 } else { traction(0.5 * (a + b)) };
         let simpson = ta + tm * 4.0 + tb;
@@ -244,7 +246,7 @@ fn inner_kink_breakpoints(
     (g0, g1): (Gap, Gap),
     mode_one: Option<&ModeOne>,
     count: usize,
-    bp: &mut [f64],
+    bp: &mut [Breakpoint],
     mut n: usize,
 ) -> usize {
     let dg = g1 - g0;
@@ -252,16 +254,20 @@ fn inner_kink_breakpoints(
     let openings = (g0[0], g1[0]);
     for k in 0..count {
         if !law.beyond_inner_kink(s0, k) && law.beyond_inner_kink(after, k) {
-            let level = mode_one.and_then(|m| m.inner[k]).map(|(g, _, _)| g);
+            let kink = mode_one.and_then(|m| m.inner[k]);
             let beyond = |t: f64| law.beyond_inner_kink(&law.evaluate(&(g0 + dg * t), s0).state, k);
-            if let Some(t) = split(pure, openings, level, &beyond) {
-                bp[n] = t;
+            if let Some(t) = split(pure, openings, kink.map(|(g, _, _)| g), &beyond) {
+                bp[n] = (t, kink.filter(|_| pure).map(|(_, traction, _)| traction));
                 n += 1;
             }
         }
     }
     n
 }
+
+/// A breakpoint of a step's gap path (a fraction of the step) and its traction, where known
+/// without evaluating the law.
+type Breakpoint = (f64, Option<Traction>);
 
 /// Recoverable energy of the interface points (N·mm) in the states of the evaluations `trial` at `gaps`.
 pub fn interface_stored(points: &[InterfacePoint], law: &dyn CohesiveLaw, trial: &[LawEval], gaps: &[Gap]) -> f64 {
