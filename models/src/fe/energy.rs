@@ -157,7 +157,7 @@ pub(crate) fn path_work_split(
     // Breakpoints: where damage starts (from a virgin state) and where it completes; each with
     // its traction where that is known without the law. A pure opening path crosses them at the
     // openings of `mode_one`, which holds the tractions there (the law is continuous at them).
-    let mut bp: [Breakpoint; 4 + super::segment::MAX_INNER_KINKS] = [(1.0, None); _];
+    let mut bp: [Breakpoint; 4 + super::segment::MAX_INNER_KINKS] = [(1.0, None); 4 + super::segment::MAX_INNER_KINKS];
     bp[0] = (0.0, Some(t0));
     let mut n = 1;
     let pure = g0[1] == 0.0 && g1[1] == 0.0;
