@@ -18,8 +18,9 @@
 //! of gaps containing the origin (its corners, the elastic domain being convex) and zero for failed
 //! material in opening; after every step the unknowns of `R` and `L` are recovered over
 //! [`CHECK_DECAYS`] decay lengths `(4EI/k_f)^{1/4}` of the beam on its elastic interface from the
-//! window and their gaps checked; at the end of the run every point is checked. A step whose check fails is repeated with a wider window; a run whose final check fails
-//! (or that does not fit the assumptions) is repeated on the whole mesh by [`super::path`]. A run
+//! window and their gaps checked; at the end of the run every point is checked. A step whose
+//! check fails is repeated with a wider window; a run whose final check fails (or that does not
+//! fit the assumptions) is repeated on the whole mesh by [`super::path`]. A run
 //! that gives up part way, where the path turns back (a specimen splitting) or the window reaches
 //! the far end, hands its last committed state to the whole mesh, which goes on from there
 //! (`Resume`) instead of starting again from rest.
