@@ -57,7 +57,7 @@ pub struct BenchOptions {
 }
 
 /// One case's outcome.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct CaseResult {
     /// Case index.
     pub index: usize,
@@ -137,6 +137,10 @@ pub struct CaseResult {
     pub pairs: Vec<(String, String, f64)>,
     /// Effect sizes drawn again because the planted model did not run to the end.
     pub redraws: usize,
+    /// Where the planted model stopped early, and why, when it stopped past the test's end (its
+    /// run up to there made the test).
+    #[serde(default)]
+    pub planted_stopped: Option<String>,
     /// Wall time (s): the synthetic test made, then diagnosed.
     pub seconds: f64,
     /// Of which making the synthetic test (s): the planted model's run (a continuum run for
@@ -235,6 +239,7 @@ fn case(
         notes: Vec::new(),
         pairs: Vec::new(),
         redraws: 0,
+        planted_stopped: None,
         seconds: 0.0,
         data_seconds: 0.0,
         diagnosis_seconds: 0.0,
@@ -243,7 +248,7 @@ fn case(
     let mut run = || -> Result<()> {
         let made = std::time::Instant::now();
         let base = family.base_setup(&draw)?;
-        let record = planted_record(&base, effect, (family, made_by), &mut size, &mut rng, &mut out)?;
+        let record = planted_record(&base, effect, (family, made_by, end), &mut size, &mut rng, &mut out)?;
         // Without a set end the test is read up to a share of the deflection at its peak load.
         let end = match end {
             Some(e) => e,
@@ -308,17 +313,20 @@ pub struct PreparedCase {
     pub options: Options,
 }
 
-/// Redraws of a planted effect's size whose model stops early or refuses it (a root compliance
+/// Redraws of a planted effect's size whose model stops early or is refused (a root compliance
 /// too large for a steep law is refused at once, see
 /// [`czid_models::effects::ROOT_COMPLIANCE_SHARE`]).
 const PLANT_REDRAWS: usize = 20;
 
-/// The planted model's record; a planted model that stops early or is refused is drawn again (up
-/// to [`PLANT_REDRAWS`] times), and the redraws counted in `out`.
+/// The planted model's record. A planted model that stops after the test's `end` (mm, the
+/// recorded displacement) made the whole test: its rows up to there are the record, and `out`
+/// says where and why it stopped. One that stops before is drawn again (up to [`PLANT_REDRAWS`]
+/// times, the redraws counted in `out`), unless the effect has no size to draw (a switch, or no
+/// effect): the same model would stop at the same place again.
 fn planted_record(
     base: &Setup,
     effect: Option<&dyn CandidateEffect>,
-    (family, made_by): (Family, Truth),
+    (family, made_by, end): (Family, Truth, Option<f64>),
     size: &mut Vec<f64>,
     rng: &mut ChaCha8Rng,
     out: &mut CaseResult,
@@ -330,15 +338,28 @@ fn planted_record(
             Some(c) => c.apply(base, size)?,
         };
         let model = made_by.model(true_setup.models[family.name()].as_ref())?;
-        match model.simulate(true_setup.law.as_ref()) {
+        let failure = match model.simulate(true_setup.law.as_ref()) {
             Ok(r) => return Ok(r),
-            Err(_) if attempt < PLANT_REDRAWS && effect.is_some() => {
-                attempt += 1;
-                out.redraws = attempt;
-                *size = effect.and_then(|c| c.plant(rng)).unwrap_or_default();
-                out.size = size.clone();
+            Err(f) => f,
+        };
+        let reached = failure.partial.column(columns::DISPLACEMENT).ok().and_then(|d| d.last().copied());
+        if let (Some(end), Some(reached)) = (end, reached) {
+            if reached >= end {
+                out.planted_stopped = Some(format!(
+                    "the planted model stopped at {reached:.4} mm, past the test's end at {end:.4} mm: {}",
+                    failure.error
+                ));
+                return Ok(failure.partial);
             }
-            Err(f) => return Err(CzError::Simulation(format!("planted model: {f}"))),
+        }
+        let redrawn = effect.and_then(|c| c.plant(rng)).unwrap_or_default();
+        if attempt < PLANT_REDRAWS && redrawn != *size {
+            attempt += 1;
+            out.redraws = attempt;
+            *size = redrawn;
+            out.size = size.clone();
+        } else {
+            return Err(CzError::Simulation(format!("planted model: {}", failure.error)));
         }
     }
 }
@@ -756,6 +777,16 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
     }
     let provisional = r.cases.iter().filter(|c| c.provisional).count();
     let _ = writeln!(s, "Provisional verdicts: {provisional} of {}.", r.cases.len());
+    let stopped: Vec<String> =
+        r.cases.iter().filter(|c| c.planted_stopped.is_some()).map(|c| c.index.to_string()).collect();
+    if !stopped.is_empty() {
+        let _ = writeln!(
+            s,
+            "Planted models that stopped early, past their test's end (their rows up to there made the test): \
+             cases {}.",
+            stopped.join(", ")
+        );
+    }
     let spread = |f: &dyn Fn(&CaseResult) -> f64| -> Option<(f64, f64)> {
         let mut t: Vec<f64> = r.cases.iter().map(f).filter(|t| t.is_finite() && *t > 0.0).collect();
         t.sort_by(f64::total_cmp);
@@ -825,4 +856,116 @@ pub fn markdown(r: &BenchReport, opts: &BenchOptions) -> String {
     }
     let _ = writeln!(s, "\nWall time {:.0} s.", r.wall_seconds);
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::candidate::EffectParameter;
+    use czid_core::{CohesiveLaw, ForwardModel, SimulationFailure};
+    use serde::{Deserialize, Serialize};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A test whose model follows the path to `stop` mm of recorded displacement and then fails.
+    #[derive(Debug, Serialize, Deserialize)]
+    struct StopsAt {
+        stop: f64,
+    }
+
+    #[typetag::serde(name = "bench_test_stops_at")]
+    impl ForwardModel for StopsAt {
+        fn name(&self) -> &str {
+            "bench_test_stops_at"
+        }
+        fn simulate(&self, _law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
+            let mut partial = Record::new(&[(columns::DISPLACEMENT, "mm"), (columns::LOAD, "N")]);
+            for i in 0..=10 {
+                let d = self.stop * i as f64 / 10.0;
+                partial.push(&[d, 10.0 * d]);
+            }
+            Err(SimulationFailure { error: CzError::Simulation("Newton did not converge".into()), partial })
+        }
+    }
+
+    /// An effect that changes nothing and counts how often it is applied; `switch`: it plants a
+    /// switch (always 1), else a size drawn at random.
+    struct Counted {
+        switch: bool,
+        applied: AtomicUsize,
+    }
+
+    impl CandidateEffect for Counted {
+        fn name(&self) -> &str {
+            "counted"
+        }
+        fn describe(&self) -> String {
+            "changes nothing".into()
+        }
+        fn applies(&self, _setup: &Setup) -> bool {
+            true
+        }
+        fn parameters(&self, _setup: &Setup) -> Result<Vec<EffectParameter>> {
+            Ok(Vec::new())
+        }
+        fn apply(&self, setup: &Setup, _values: &[f64]) -> Result<Setup> {
+            self.applied.fetch_add(1, Ordering::SeqCst);
+            setup.duplicate()
+        }
+        fn plant(&self, rng: &mut ChaCha8Rng) -> Option<Vec<f64>> {
+            Some(vec![if self.switch { 1.0 } else { rng.random_range(0.0..1.0) }])
+        }
+    }
+
+    fn setup(stop: f64) -> Setup {
+        let law = czid_models::laws::Bilinear::bk(1e5, 30.0, 40.0, 0.3, 0.8, 2.0).unwrap();
+        let model: Box<dyn ForwardModel> = Box::new(StopsAt { stop });
+        Setup { law: Box::new(law), models: [("dcb".to_string(), model)].into_iter().collect() }
+    }
+
+    fn planted(effect: &Counted, end: f64) -> (Result<Record>, CaseResult) {
+        let mut out = CaseResult::default();
+        let mut size = vec![1.0];
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let r = planted_record(
+            &setup(5.0),
+            Some(effect),
+            (Family::Dcb, Truth::Beam, Some(end)),
+            &mut size,
+            &mut rng,
+            &mut out,
+        );
+        (r, out)
+    }
+
+    #[test]
+    fn a_planted_model_that_stops_past_the_tests_end_made_the_whole_test() {
+        let effect = Counted { switch: true, applied: AtomicUsize::new(0) };
+        let (record, out) = planted(&effect, 4.0);
+        let record = record.expect("the rows up to the stop cover the test");
+        assert_eq!(record.rows(), 11);
+        assert_eq!(record.column(columns::DISPLACEMENT).unwrap().last(), Some(&5.0));
+        let why = out.planted_stopped.expect("where it stopped is said");
+        assert!(why.contains("5.0000 mm") && why.contains("4.0000 mm") && why.contains("Newton"), "{why}");
+        assert_eq!((out.redraws, effect.applied.load(Ordering::SeqCst)), (0, 1));
+    }
+
+    #[test]
+    fn a_planted_switch_that_stops_before_the_tests_end_is_not_run_again() {
+        // The same model would stop at the same place: one run, then the error.
+        let effect = Counted { switch: true, applied: AtomicUsize::new(0) };
+        let (record, out) = planted(&effect, 6.0);
+        let e = record.expect_err("the test reads past the stop").to_string();
+        assert!(e.contains("planted model") && e.contains("Newton"), "{e}");
+        assert_eq!((out.redraws, effect.applied.load(Ordering::SeqCst)), (0, 1));
+        assert!(out.planted_stopped.is_none());
+    }
+
+    #[test]
+    fn a_planted_size_that_stops_before_the_tests_end_is_drawn_again() {
+        let effect = Counted { switch: false, applied: AtomicUsize::new(0) };
+        let (record, out) = planted(&effect, 6.0);
+        assert!(record.is_err());
+        assert_eq!((out.redraws, effect.applied.load(Ordering::SeqCst)), (PLANT_REDRAWS, PLANT_REDRAWS + 1));
+        assert_eq!(out.size.len(), 1);
+    }
 }
