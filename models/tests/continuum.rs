@@ -146,6 +146,8 @@ fn a_running_crack_costs_a_few_newton_iterations_per_step_and_the_steps_do_not_m
     );
     assert!(grown > 20.0, "the crack grew {grown} mm");
     assert!(per_step <= 12.0, "{per_step} factorisations a step ({stats:?})");
+    // A path that converges at the tolerance never needs the round-off floor.
+    assert_eq!(stats.floor_steps, 0, "{stats:?}");
     let mut fine = dcb.clone();
     fine.control.output_points *= 4;
     let f = fine.simulate(&law).unwrap();
@@ -450,13 +452,20 @@ fn a_long_large_rotation_run_is_followed_past_the_residuals_round_off_floor() {
     dcb.mesh.thickness_elements = 6;
     let law =
         Bilinear::bk(1e5, 28.848_763_861_520_474, 28.848_763_861_520_474, 0.498_770_105_861_469_8, 2.0, 2.0).unwrap();
-    let r = dcb.simulate(&law).unwrap();
+    let (r, stats) = dcb.simulate_with_stats(&law).unwrap();
     let d = r.column(columns::DISPLACEMENT).unwrap();
     assert!(*d.last().unwrap() >= end * (1.0 - 1e-9), "stopped at {} of {end} mm", d.last().unwrap());
+    // The run did meet the floor (it used to stop there), and went on from it.
+    assert!(stats.floor_steps > 0, "{stats:?}");
     let w = r.column(columns::EXTERNAL_WORK).unwrap();
     let u = r.column(columns::ELASTIC_ENERGY).unwrap();
     let dis = r.column(columns::DISSIPATED_ENERGY).unwrap();
     let worst = (1..w.len()).map(|i| ((w[i] - u[i] - dis[i]) / w[i]).abs()).fold(0.0, f64::max);
-    eprintln!("reached {} mm; worst energy imbalance {worst:.2e}", d.last().unwrap());
+    eprintln!(
+        "reached {} mm in {} steps, {} at the floor; worst energy imbalance {worst:.2e}",
+        d.last().unwrap(),
+        stats.steps,
+        stats.floor_steps
+    );
     assert!(worst <= 0.005, "energy imbalance {worst}");
 }
