@@ -22,6 +22,7 @@ use nalgebra::Vector4;
 use super::measures::{measure, CrackMeasures};
 use super::problem::{Assembled, ContinuumProblem, Elements};
 use super::solver::System;
+use crate::fe::newton::ROUND_OFF_FLOOR;
 
 /// Settings of a run.
 #[derive(Clone, Debug, PartialEq)]
@@ -130,21 +131,20 @@ struct Solver<'a> {
     held: Vec<bool>,
     stats: Stats,
     settings: &'a PathSettings,
-    /// Accept a step whose residual has settled at the round-off floor (see [`FLOOR_FACTOR`]).
+    /// Accept a step whose residual has settled at the round-off floor (see [`FLOOR_ITERATIONS`]).
     /// Switched on only where the path would otherwise stop, so runs that converge are untouched.
     accept_floor: bool,
 }
 
-/// A step whose residual stays within this factor of the tolerance for [`FLOOR_ITERATIONS`]
-/// iterations without falling has reached the floor the arithmetic of its states allows.
+/// Where no step converges however short, a step whose residual stays within
+/// [`ROUND_OFF_FLOOR`] times the tolerance for this many iterations without falling has reached
+/// the floor the arithmetic of its states allows, as the beam engine's dissipation-controlled
+/// steps do.
 ///
 /// On long total-Lagrangian runs (large rotations of a stiff arm, a crack far along) the
 /// residual of a converged step settles at 1.0–1.3 times a 10⁻⁸ tolerance and stays there while
 /// the applied displacement no longer moves: cutting the step does not lower it, and the path
 /// would stop with the state found. Accepting such a step is accepting what the arithmetic gives.
-const FLOOR_FACTOR: f64 = 10.0;
-
-/// Iterations over which a residual at the floor must have stopped falling (see [`FLOOR_FACTOR`]).
 const FLOOR_ITERATIONS: usize = 5;
 
 /// Follows the path of `p` with `law` to `settings.target`.
@@ -472,14 +472,14 @@ impl Solver<'_> {
     }
 }
 
-/// Whether the last [`FLOOR_ITERATIONS`] relative residuals all lie within [`FLOOR_FACTOR`] of
+/// Whether the last [`FLOOR_ITERATIONS`] relative residuals all lie within [`ROUND_OFF_FLOOR`] times
 /// `tolerance` and the last is no lower than half the first of them: Newton has stopped gaining,
 /// at a level just above the tolerance.
 fn at_floor(history: &[f64], tolerance: f64) -> bool {
     let Some(last) = history.len().checked_sub(FLOOR_ITERATIONS).map(|i| &history[i..]) else {
         return false;
     };
-    last.iter().all(|&r| r <= FLOOR_FACTOR * tolerance) && last[FLOOR_ITERATIONS - 1] >= 0.5 * last[0]
+    last.iter().all(|&r| r <= ROUND_OFF_FLOOR * tolerance) && last[FLOOR_ITERATIONS - 1] >= 0.5 * last[0]
 }
 
 /// Effective opening `√(⟨g_n⟩² + g_t²)` (mm).
