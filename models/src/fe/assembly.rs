@@ -13,7 +13,7 @@
 
 use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent};
 
-use super::banded::BandMatrix;
+use super::banded::{BandMatrix, RowSparse};
 use super::beam;
 use super::corotational;
 use super::interface::{self, GapKinematics, InterfacePoint, PointKind, POINT_DOFS, SIDE};
@@ -117,6 +117,9 @@ pub struct Assembler {
     elements: Vec<Element>,
     /// Constant part of the tangent (small-rotation beams and springs); empty band otherwise.
     pub linear: BandMatrix,
+    /// Its non-zero entries, for the forces: a row of a beam mesh's band holds a few times more
+    /// zeros than entries.
+    linear_entries: RowSparse,
     /// Trial law results of the last assembly, one per interface point.
     pub trial: Vec<LawEval>,
     /// Gaps of the last assembly.
@@ -201,6 +204,7 @@ impl Assembler {
         let large = p.large_rotation && !segments.is_empty();
         Assembler {
             elements,
+            linear_entries: RowSparse::from_band(&linear),
             linear,
             trial: vec![zero; np],
             gaps: vec![Gap::zeros(); np],
@@ -252,7 +256,7 @@ impl Assembler {
             }
         } else {
             k.copy_from(&self.linear);
-            self.linear.mul_vec(q, f);
+            self.linear_entries.mul_vec(q, f);
         }
         if p.large_rotation {
             for e in self.elements.iter().filter(|e| e.node + 1 < self.frozen_from_node) {

@@ -109,6 +109,13 @@ impl BandMatrix {
         self.bw
     }
 
+    /// Row `i`'s stored band, `2 bw + 1` entries: column `j` at position `j + bw − i` (entries
+    /// outside the matrix are zero).
+    #[inline]
+    pub(crate) fn band_row(&self, i: usize) -> &[f64] {
+        &self.data[i * self.width..(i + 1) * self.width]
+    }
+
     /// Sets every stored entry to zero (keeps the allocation).
     pub fn clear(&mut self) {
         self.data.fill(0.0);

@@ -8,6 +8,7 @@
 //! * [`segment`]: exact integration of the interface between points, with kinks at damage fronts;
 //! * [`assembly`]: the discrete problem and assembly of forces and tangent;
 //! * [`banded`]: band LU factorisation (the linear solver);
+//! * [`span_lu`]: the band LU refactorising only the rows that changed since the last one;
 //! * [`symmetric_band`]: its `L D Lᵀ` counterpart for symmetric iteration matrices;
 //! * [`newton`]: Newton–Raphson under displacement or dissipation control;
 //! * [`path`]: path following (adaptive steps, output grid, snap-back detours);
@@ -46,6 +47,7 @@ pub mod path;
 pub(crate) mod pool;
 pub mod run_types;
 pub mod segment;
+pub mod span_lu;
 pub mod symmetric_band;
 pub(crate) mod window;
 

@@ -5,6 +5,7 @@ use czid_core::{CohesiveLaw, LawState};
 
 use super::assembly::{Assembler, FeProblem, InterfaceRule};
 use super::banded::BandMatrix;
+use super::span_lu::SpanLu;
 
 /// Convergence settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,8 +50,12 @@ pub enum StepFailure {
 pub struct Newton {
     /// Assembly workspace (constant tangent part, trial law results).
     pub asm: Assembler,
-    /// Tangent, factorised in place.
+    /// Tangent (as assembled; factorised by `lu`).
     pub k: BandMatrix,
+    /// Its factors: only the rows that changed since the last factorisation are refactorised
+    /// (the process zone's, where the beams are linear and the interface elsewhere keeps its
+    /// stiffness).
+    lu: SpanLu,
     /// Internal forces at the last assembly.
     pub f: Vec<f64>,
     r: Vec<f64>,
@@ -86,6 +91,7 @@ impl Newton {
         }
         Newton {
             k: BandMatrix::zeros(n, p.mesh.bandwidth()),
+            lu: SpanLu::default(),
             asm,
             f: vec![0.0; n],
             r: vec![0.0; n],
@@ -181,9 +187,9 @@ impl Newton {
             self.counters.1 += 1;
             let n = self.k.n();
             self.k.set_order(self.active);
-            let factorized = self.k.factorize();
+            let factorized = self.lu.factorize(&self.k);
             if factorized.is_ok() {
-                self.k.solve_in_place(&mut self.r);
+                self.lu.solve_in_place(&mut self.r);
             }
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
@@ -252,9 +258,9 @@ impl Newton {
             self.b[ic] = 1.0;
             let n = self.k.n();
             self.k.set_order(self.active);
-            let factorized = self.k.factorize();
+            let factorized = self.lu.factorize(&self.k);
             if factorized.is_ok() {
-                self.k.solve2_in_place(&mut self.r, &mut self.b);
+                self.lu.solve2_in_place(&mut self.r, &mut self.b);
             }
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
