@@ -204,7 +204,8 @@ impl Assembler {
         let large = p.large_rotation && !segments.is_empty();
         Assembler {
             elements,
-            linear_entries: RowSparse::from_band(&linear),
+            // (Under large rotations the band is empty: the springs are added directly.)
+            linear_entries: if p.large_rotation { RowSparse::default() } else { RowSparse::from_band(&linear) },
             linear,
             trial: vec![zero; np],
             gaps: vec![Gap::zeros(); np],

@@ -109,6 +109,17 @@ impl BandMatrix {
         self.bw
     }
 
+    /// Copies the leading `self.n()` rows of `other` (same bandwidth, at least as many rows).
+    pub(crate) fn copy_leading_from(&mut self, other: &BandMatrix) {
+        let len = self.n * self.width;
+        self.data[..len].copy_from_slice(&other.data[..len]);
+    }
+
+    /// The factors in band rows and the reciprocal pivots, after [`BandMatrix::factorize`].
+    pub(crate) fn factors(&self) -> (&[f64], &[f64]) {
+        (&self.data[..self.n * self.width], &self.inv_pivot[..self.n])
+    }
+
     /// Row `i`'s stored band, `2 bw + 1` entries: column `j` at position `j + bw − i` (entries
     /// outside the matrix are zero).
     #[inline]
@@ -503,7 +514,7 @@ impl BandMatrix {
 
 /// The non-zero entries of a matrix by rows, in column order: its product with a vector skips
 /// the band's zeros, with the same sums as [`BandMatrix::mul_vec`] (a zero entry adds nothing).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct RowSparse {
     /// Row `i`'s entries are `start[i]..start[i + 1]`.
     start: Vec<usize>,

@@ -50,12 +50,13 @@ pub enum StepFailure {
 pub struct Newton {
     /// Assembly workspace (constant tangent part, trial law results).
     pub asm: Assembler,
-    /// Tangent (as assembled; factorised by `lu`).
+    /// Tangent (as assembled; factorised by `lu` or in place).
     pub k: BandMatrix,
-    /// Its factors: only the rows that changed since the last factorisation are refactorised
-    /// (the process zone's, where the beams are linear and the interface elsewhere keeps its
-    /// stiffness).
-    lu: SpanLu,
+    /// Its factors, where only the rows that changed since the last factorisation are
+    /// refactorised (small rotations: the beams are linear and the interface keeps its stiffness
+    /// outside the process zone); `None`: `k` is factorised in place (under large rotations every
+    /// co-rotational beam changes, and comparing and copying the tangent would only add work).
+    lu: Option<SpanLu>,
     /// Internal forces at the last assembly.
     pub f: Vec<f64>,
     r: Vec<f64>,
@@ -91,7 +92,7 @@ impl Newton {
         }
         Newton {
             k: BandMatrix::zeros(n, p.mesh.bandwidth()),
-            lu: SpanLu::default(),
+            lu: (!p.large_rotation).then(SpanLu::default),
             asm,
             f: vec![0.0; n],
             r: vec![0.0; n],
@@ -187,10 +188,10 @@ impl Newton {
             self.counters.1 += 1;
             let n = self.k.n();
             self.k.set_order(self.active);
-            let factorized = self.lu.factorize(&self.k);
-            if factorized.is_ok() {
-                self.lu.solve_in_place(&mut self.r);
-            }
+            let factorized = match self.lu.as_mut() {
+                Some(lu) => lu.factorize(&self.k).inspect(|_| lu.solve_in_place(&mut self.r)),
+                None => self.k.factorize().inspect(|_| self.k.solve_in_place(&mut self.r)),
+            };
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
             let (mut dmax, mut qmax) = (0.0f64, 0.0f64);
@@ -258,10 +259,10 @@ impl Newton {
             self.b[ic] = 1.0;
             let n = self.k.n();
             self.k.set_order(self.active);
-            let factorized = self.lu.factorize(&self.k);
-            if factorized.is_ok() {
-                self.lu.solve2_in_place(&mut self.r, &mut self.b);
-            }
+            let factorized = match self.lu.as_mut() {
+                Some(lu) => lu.factorize(&self.k).inspect(|_| lu.solve2_in_place(&mut self.r, &mut self.b)),
+                None => self.k.factorize().inspect(|_| self.k.solve2_in_place(&mut self.r, &mut self.b)),
+            };
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
             // Bordering: Δq = a + Δλ b, with the constraint linearised in (c, λ).

@@ -122,6 +122,10 @@ pub struct SpanLu {
     boundary_l: Vec<f64>,
     /// Work array of the solves.
     scratch: Vec<f64>,
+    /// Where every row is to be refactorised: the band LU itself (its fixed-bandwidth kernels),
+    /// whose factors `top` takes over when a later factorisation can keep some.
+    full: BandMatrix,
+    full_mode: bool,
     /// Rows eliminated since construction (a full band LU eliminates `n` per factorisation).
     pub rows_eliminated: usize,
 }
@@ -138,12 +142,12 @@ impl SpanLu {
             self.reference.clear();
             self.reference.resize(n * w, 0.0);
             self.valid = false;
-            self.top.reset(n, w);
-            self.bottom.reset(n, w);
-            self.boundary = vec![0.0; bw * w];
-            self.boundary_l = vec![0.0; bw * bw];
+            // The parts are allocated at the first split.
+            (self.top.len, self.bottom.len) = (0, 0);
             self.s = n;
             self.top_clean = 0;
+            self.full = BandMatrix::zeros(n, bw);
+            self.full_mode = false;
         }
         // Bit for bit (an OR of XORs, which vectorises; a row is short).
         let same = |i: usize| {
@@ -169,7 +173,28 @@ impl SpanLu {
         let tiny = scale * 1e-14;
         // A trailing part of a band or less is not worth its condensation.
         let s = if n - 1 - last > bw { last + 1 } else { n };
+        // Where most rows changed, the band LU's fixed-bandwidth kernels refactorise them faster
+        // than a split would (co-rotational beams change every row).
         let nb_rows = if s < n { bw.min(s) } else { 0 };
+        if 2 * (last + 1 - first) >= n || s == n && first == 0 {
+            self.full.copy_leading_from(a);
+            self.full.factorize()?;
+            self.rows_eliminated += n;
+            (self.full_mode, self.valid, self.s) = (true, true, n);
+            return Ok(());
+        }
+        if self.top.data.len() != n * w {
+            self.top.reset(n, w);
+            self.bottom.reset(n, w);
+            self.boundary = vec![0.0; bw * w];
+            self.boundary_l = vec![0.0; bw * bw];
+        }
+        if self.full_mode {
+            let (factors, inv) = self.full.factors();
+            self.top.data[..n * w].copy_from_slice(factors);
+            self.top.inv_pivot[..n].copy_from_slice(inv);
+            (self.top.len, self.top_clean, self.bottom.len, self.full_mode) = (n, n, 0, false);
+        }
         // What each part keeps: the top its rows before the first change that hold neither the
         // old nor the new trailing part's condensed stiffness; the bottom its rows after the last
         // change.
@@ -231,6 +256,9 @@ impl SpanLu {
 
     /// Solves `A x = b` in place with the factors of the last [`SpanLu::factorize`].
     pub fn solve_in_place(&mut self, b: &mut [f64]) {
+        if self.full_mode {
+            return self.full.solve_in_place(b);
+        }
         let (n, bw, s) = (self.n, self.bw, self.s);
         let w = 2 * bw + 1;
         let nb = n - s;
@@ -289,6 +317,9 @@ impl SpanLu {
 
     /// Solves `A x = b1` and `A y = b2` in place.
     pub fn solve2_in_place(&mut self, b1: &mut [f64], b2: &mut [f64]) {
+        if self.full_mode {
+            return self.full.solve2_in_place(b1, b2);
+        }
         self.solve_in_place(b1);
         self.solve_in_place(b2);
     }
