@@ -4,7 +4,7 @@
 use czid_core::{CohesiveLaw, LawState};
 
 use super::assembly::{Assembler, FeProblem, InterfaceRule};
-use super::banded::BandMatrix;
+use super::banded::{BandError, BandMatrix};
 use super::span_lu::SpanLu;
 
 /// Convergence settings.
@@ -123,6 +123,20 @@ impl Newton {
         }
     }
 
+    /// Factorises the tangent and solves for the residual `r` in place (and for `b` with `both`).
+    fn factorize_and_solve(&mut self, both: bool) -> Result<(), BandError> {
+        match self.lu.as_mut() {
+            Some(lu) => lu.factorize(&self.k).inspect(|_| match both {
+                true => lu.solve2_in_place(&mut self.r, &mut self.b),
+                false => lu.solve_in_place(&mut self.r),
+            }),
+            None => self.k.factorize().inspect(|_| match both {
+                true => self.k.solve2_in_place(&mut self.r, &mut self.b),
+                false => self.k.solve_in_place(&mut self.r),
+            }),
+        }
+    }
+
     fn scale(&self) -> f64 {
         self.f.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300)
     }
@@ -188,10 +202,7 @@ impl Newton {
             self.counters.1 += 1;
             let n = self.k.n();
             self.k.set_order(self.active);
-            let factorized = match self.lu.as_mut() {
-                Some(lu) => lu.factorize(&self.k).inspect(|_| lu.solve_in_place(&mut self.r)),
-                None => self.k.factorize().inspect(|_| self.k.solve_in_place(&mut self.r)),
-            };
+            let factorized = self.factorize_and_solve(false);
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
             let (mut dmax, mut qmax) = (0.0f64, 0.0f64);
@@ -259,10 +270,7 @@ impl Newton {
             self.b[ic] = 1.0;
             let n = self.k.n();
             self.k.set_order(self.active);
-            let factorized = match self.lu.as_mut() {
-                Some(lu) => lu.factorize(&self.k).inspect(|_| lu.solve2_in_place(&mut self.r, &mut self.b)),
-                None => self.k.factorize().inspect(|_| self.k.solve2_in_place(&mut self.r, &mut self.b)),
-            };
+            let factorized = self.factorize_and_solve(true);
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
             // Bordering: Δq = a + Δλ b, with the constraint linearised in (c, λ).
