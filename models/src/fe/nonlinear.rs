@@ -63,14 +63,6 @@ use crate::materials::UniaxialState;
 /// 477 MPa/mm over 10 × 100 mm is 0.5 N per mm of lift.
 pub const RESIDUAL_OPENING_STIFFNESS: f64 = 1e-6;
 
-/// Residual, relative to the largest internal force, below which the normal statuses of the
-/// interface are checked (and corrected) before the iterations converge ([`Solver::newton`]). On
-/// the paper's beam 10⁻⁴ takes 14 % fewer instructions than checking at convergence only, and
-/// moves its record by 1.7 × 10⁻⁸ of the peak load; 10⁻² moves it by 3 × 10⁻⁵ (statuses taken
-/// from gaps further from the solution flip more often, and the two corrections a step allows run
-/// out elsewhere).
-const STATUS_CHECK_BELOW: f64 = 1e-4;
-
 /// A mesh layer whose axial force and moment come from a fibre section.
 #[derive(Clone, Debug)]
 pub struct FibreLayer {
@@ -283,8 +275,6 @@ struct Solver<'a> {
     with_compliance: bool,
     /// Secant iterations after a correction that increased the residual.
     secant_iterations: usize,
-    /// [`STATUS_CHECK_BELOW`] (0: the statuses are checked at convergence only).
-    status_check_below: f64,
     /// Extrapolated damage of each point in this step (`None`: the law's own response).
     extrapolated: Option<Vec<f64>>,
     /// The law's initial stiffness `[k_n, k_t]` (MPa/mm).
@@ -461,7 +451,6 @@ impl<'a> Solver<'a> {
             stats: NonlinearStats::default(),
             with_compliance: p.compliance != [0.0, 0.0],
             secant_iterations: 4,
-            status_check_below: STATUS_CHECK_BELOW,
             extrapolated: None,
             k0: law.initial_stiffness(),
             fibre_loading: vec![false; nfib],
@@ -818,8 +807,7 @@ impl<'a> Solver<'a> {
             if !self.assemble(c, q, secant_left > 0) {
                 return None;
             }
-            let scale = self.scale();
-            let tol = self.settings.tolerance * scale;
+            let tol = self.settings.tolerance * self.scale();
             let mut rmax = 0.0f64;
             for i in 0..n {
                 let v = if self.fixed_mask[i] { 0.0 } else { self.f[i] - *load * self.load[i] };
@@ -831,21 +819,6 @@ impl<'a> Solver<'a> {
             }
             let ctl: f64 = self.p.control.iter().map(|&(d, a)| a * q[d]).sum();
             let cres = c_target.map_or(0.0, |t| t - ctl);
-            // The normal statuses are checked once the residual is small, before the iterations
-            // converge: the gaps are then those of the solution to a few digits, and a status
-            // corrected here saves the iterations of a new start from the converged state (and
-            // the assembly that found it converged).
-            if corrections < 2
-                && rmax > tol
-                && rmax <= self.status_check_below * scale
-                && cres.abs() <= 1e-9 * ctl.abs().max(1e-9)
-                && self.correct_status(tol)
-            {
-                corrections += 1;
-                self.base.same_unknowns = true;
-                r_prev = f64::INFINITY;
-                continue;
-            }
             if rmax <= tol && cres.abs() <= 1e-12 * ctl.abs().max(1e-9) {
                 // At most two corrections of the normal statuses per step: beyond, a debonded
                 // plate lying on the soffit keeps switching points between touching and lifting by
@@ -946,18 +919,6 @@ pub fn run(
     path: &ControlPath,
     observe: &mut dyn FnMut(&Snapshot) -> bool,
 ) -> Result<(Vec<NonlinearRow>, NonlinearStats), NonlinearFailure> {
-    run_checking_statuses_below(p, law, path, observe, STATUS_CHECK_BELOW)
-}
-
-/// [`run`], the interface's normal statuses checked from the residual `status_check_below` on
-/// (relative to the largest internal force; 0: at convergence only).
-fn run_checking_statuses_below(
-    p: &NonlinearProblem,
-    law: &dyn CohesiveLaw,
-    path: &ControlPath,
-    observe: &mut dyn FnMut(&Snapshot) -> bool,
-    status_check_below: f64,
-) -> Result<(Vec<NonlinearRow>, NonlinearStats), NonlinearFailure> {
     let fail = |rows: Vec<NonlinearRow>, msg: String| NonlinearFailure { error: CzError::Simulation(msg), rows };
     if let Err(e) = check(p) {
         return Err(NonlinearFailure { error: e, rows: Vec::new() });
@@ -981,8 +942,6 @@ fn run_checking_statuses_below(
         }
     };
     let mut s = Solver::new(p, law, path.newton);
-    s.status_check_below = status_check_below;
-    s.status_check_below = status_check_below;
     let n = p.mesh.n_dofs();
     let mut committed = s.trial.clone();
     let mut q = vec![0.0; n];
@@ -1261,56 +1220,4 @@ fn check_secant_unloading(law: &dyn CohesiveLaw) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::frp::beam::FrpBeam;
-
-    /// The paper's plated beam with the Table 8 law until 1850 mm of its 1900 mm half plate have
-    /// debonded (past the peak, through the runs of IC debonding), its statuses checked from
-    /// `status_check_below` on: rows and statistics.
-    fn paper_beam(status_check_below: f64) -> (Vec<NonlinearRow>, NonlinearStats) {
-        let beam = FrpBeam::paper().unwrap();
-        let law = FrpBeam::table8_law().unwrap();
-        let (p, _) = beam.problem(&law).unwrap();
-        let mut until_debonded = |s: &Snapshot| s.row.crack.debonded >= 1850.0;
-        run_checking_statuses_below(&p, &law, &beam.control_path(), &mut until_debonded, status_check_below)
-            .map_err(|f| f.error)
-            .unwrap()
-    }
-
-    /// Checking the normal statuses of the interface before the iterations converge (the debonded
-    /// plate lying on the soffit, whose points touch and lift) reaches the states of checking them
-    /// at convergence only, within the Newton tolerance's reach, and takes fewer assemblies and
-    /// factorisations.
-    #[test]
-    fn statuses_checked_before_convergence_give_the_same_states_for_less_work() {
-        let (late, late_stats) = paper_beam(0.0);
-        let (early, early_stats) = paper_beam(STATUS_CHECK_BELOW);
-        assert_eq!(early.len(), late.len());
-        let peak = late.iter().fold(0.0f64, |m, r| m.max(r.load.abs()));
-        let reach = late.iter().fold(0.0f64, |m, r| m.max(r.displacement.abs()));
-        let work = late.iter().fold(0.0f64, |m, r| m.max(r.external_work.abs()));
-        let worst = early.iter().zip(&late).fold(0.0f64, |m, (a, b)| m.max((a.load - b.load).abs() / peak));
-        println!(
-            "{} rows, largest load difference {worst:.2e} of the peak; {early_stats:?} against {late_stats:?}",
-            late.len()
-        );
-        for (a, b) in early.iter().zip(&late) {
-            assert!(
-                (a.control - b.control).abs() <= 1e-12 * b.control.abs().max(1.0),
-                "{} vs {}",
-                a.control,
-                b.control
-            );
-            assert!((a.load - b.load).abs() <= 1e-7 * peak, "load {} vs {} at control {}", a.load, b.load, b.control);
-            assert!((a.displacement - b.displacement).abs() <= 1e-7 * reach, "at control {}", b.control);
-            assert!((a.external_work - b.external_work).abs() <= 1e-7 * work, "at control {}", b.control);
-            assert!((a.crack.debonded - b.crack.debonded).abs() <= 1e-6, "at control {}", b.control);
-        }
-        assert!(early_stats.assemblies < late_stats.assemblies, "{early_stats:?} against {late_stats:?}");
-        assert!(early_stats.factorizations < late_stats.factorizations, "{early_stats:?} against {late_stats:?}");
-    }
 }

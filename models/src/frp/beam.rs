@@ -280,7 +280,7 @@ pub struct BeamRun {
 
 /// Node indices of the half-beam mesh.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Layout {
+struct Layout {
     load: usize,
     support: usize,
     plate_end: usize,
@@ -494,7 +494,7 @@ impl FrpBeam {
     }
 
     /// Builds the discrete half-beam problem for `law`.
-    pub(crate) fn problem(&self, law: &dyn CohesiveLaw) -> Result<(NonlinearProblem, Layout)> {
+    fn problem(&self, law: &dyn CohesiveLaw) -> Result<(NonlinearProblem, Layout)> {
         self.validate()?;
         let plate = self.section.plate.as_ref().ok_or_else(|| CzError::config(OWNER, "section.plate is missing"))?;
         let half = |v: f64| 0.5 * v;
@@ -570,10 +570,12 @@ impl FrpBeam {
     }
 
     /// Runs the beam with `law`; with `profiles`, also the state along the plate at every row.
-    /// The engine's path: soffit elongation from the control settings, damage extrapolated.
-    pub(crate) fn control_path(&self) -> ControlPath {
+    pub fn run(&self, law: &dyn CohesiveLaw, profiles: bool) -> std::result::Result<BeamRun, SimulationFailure> {
+        let fail = |error: CzError| SimulationFailure { error, partial: new_record() };
+        law.validate().map_err(fail)?;
+        let (p, layout) = self.problem(law).map_err(fail)?;
         let c = &self.control;
-        ControlPath {
+        let path = ControlPath {
             spacing: c.elongation_step,
             max_control: c.max_elongation,
             min_step_fraction: 1e-4,
@@ -583,15 +585,7 @@ impl FrpBeam {
                 tolerance: c.damage_tolerance,
                 min_fraction: c.min_step_fraction,
             },
-        }
-    }
-
-    pub fn run(&self, law: &dyn CohesiveLaw, profiles: bool) -> std::result::Result<BeamRun, SimulationFailure> {
-        let fail = |error: CzError| SimulationFailure { error, partial: new_record() };
-        law.validate().map_err(fail)?;
-        let (p, layout) = self.problem(law).map_err(fail)?;
-        let c = &self.control;
-        let path = self.control_path();
+        };
         let eps_cu = self.section.concrete.crushing_strain;
         let z_top = 0.5 * self.section.height;
         let ratio = self.mesh.interface_element / self.cracks.spacing;
