@@ -303,7 +303,7 @@ impl Dcb {
         self.effects.interface_law(law)
     }
 
-    fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
+    pub(crate) fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
         // The debonded length is the visible crack (what a camera sees). The record ends where the
         // arms have sprung back (`until_split`): the run need not go further.
         let path = self.control.path(self.max_opening(law) / scale.displacement, self.effective_crack_length());

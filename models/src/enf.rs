@@ -174,7 +174,7 @@ impl Enf {
         Ok((p, scale))
     }
 
-    fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
+    pub(crate) fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale) -> PathSettings {
         self.control
             .path(self.max_deflection(law) / scale.displacement, self.effective_crack_length())
             .with_visible_front(law, 1)

@@ -262,7 +262,7 @@ impl Mmb {
     }
 
     /// [`Mmb::problem`] and the compliance of the lever's springs in it (mm/N).
-    fn build(&self, law: &dyn CohesiveLaw) -> Result<(FeProblem, RowScale, f64)> {
+    pub(crate) fn build(&self, law: &dyn CohesiveLaw) -> Result<(FeProblem, RowScale, f64)> {
         self.validate()?;
         let fx = &self.effects;
         let (a, l, c) = (self.effective_crack_length(), self.half_span, self.lever);
@@ -322,7 +322,7 @@ impl Mmb {
     /// The path in the control unknown, which also moves with the lever's own compliance: to
     /// record the specimen up to `max_displacement` it runs further by `C_lever P_c` (`P_c` the
     /// beam-theory onset load), so the record ends at, or a little beyond, `max_displacement`.
-    fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale, lever_compliance: f64) -> PathSettings {
+    pub(crate) fn path(&self, law: &dyn CohesiveLaw, scale: &RowScale, lever_compliance: f64) -> PathSettings {
         let a = self.effective_crack_length();
         let lever = lever_compliance * self.onset_load(law);
         // Mixed mode: the segment rule places the visible front at the law's kink whatever the

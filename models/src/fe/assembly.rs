@@ -229,8 +229,9 @@ impl Assembler {
         }
     }
 
-    /// Internal forces `f` and tangent `k` at `q`, laws evaluated from the committed `states`.
-    /// Returns `false` if a law returned a non-finite value.
+    /// Internal forces `f` and tangent `k` at `q`, laws evaluated from the committed `states`;
+    /// with `k` `None`, the forces only (and the law results), `k` left as it is (a chord step
+    /// reuses its factors). Returns `false` if a law returned a non-finite value.
     #[allow(clippy::too_many_arguments)]
     pub fn assemble(
         &mut self,
@@ -238,14 +239,16 @@ impl Assembler {
         law: &dyn CohesiveLaw,
         states: &[LawState],
         q: &[f64],
-        k: &mut BandMatrix,
+        mut k: Option<&mut BandMatrix>,
         f: &mut [f64],
         secant: bool,
     ) -> bool {
         if p.large_rotation {
             // The constant part is the springs alone: added directly rather than by copying and
             // multiplying a band that is empty elsewhere.
-            k.clear();
+            if let Some(k) = k.as_deref_mut() {
+                k.clear();
+            }
             f.fill(0.0);
             for s in &p.springs {
                 let e = s.elongation(q);
@@ -253,10 +256,14 @@ impl Assembler {
                 if s.j != NONE {
                     f[s.j] -= s.k * e;
                 }
-                s.stiffness_into(k);
+                if let Some(k) = k.as_deref_mut() {
+                    s.stiffness_into(k);
+                }
             }
         } else {
-            k.copy_from(&self.linear);
+            if let Some(k) = k.as_deref_mut() {
+                k.copy_from(&self.linear);
+            }
             self.linear_entries.mul_vec(q, f);
         }
         if p.large_rotation {
@@ -272,7 +279,9 @@ impl Assembler {
                     }
                     f[da] += cr.force[a];
                 }
-                scatter(k, &e.dofs, &cr.tangent);
+                if let Some(k) = k.as_deref_mut() {
+                    scatter(k, &e.dofs, &cr.tangent);
+                }
             }
         }
         let mut ok = true;
@@ -333,6 +342,9 @@ impl Assembler {
                     continue;
                 }
                 f[da] += w * (g[0][a] * t[0] + g[1][a] * t[1]);
+                let Some(k) = k.as_deref_mut() else {
+                    continue;
+                };
                 // Row a of Gᵀ D: (g0a D00 + g1a D10, g0a D01 + g1a D11)
                 let ra0 = g[0][a] * d[(0, 0)] + g[1][a] * d[(1, 0)];
                 let ra1 = g[0][a] * d[(0, 1)] + g[1][a] * d[(1, 1)];
@@ -369,9 +381,9 @@ impl Assembler {
             let hess = [self.hessians.get(sg.a), self.hessians.get(sg.b)];
             // Both points on a symmetry plane (a half DCB): only their upper sides have unknowns.
             if pts[0].first == SIDE && pts[1].first == SIDE {
-                add_segment::<SIDE>(k, f, pts, hess, &sf);
+                add_segment::<SIDE>(k.as_deref_mut(), f, pts, hess, &sf);
             } else {
-                add_segment::<0>(k, f, pts, hess, &sf);
+                add_segment::<0>(k.as_deref_mut(), f, pts, hess, &sf);
             }
         }
         ok
@@ -437,7 +449,7 @@ impl Assembler {
 /// with nonlinear kinematics) for its end points `pts`, whose unknowns are among
 /// `kin.dofs[FIRST..]` (a constant, so the loops unroll).
 fn add_segment<const FIRST: usize>(
-    k: &mut BandMatrix,
+    mut k: Option<&mut BandMatrix>,
     f: &mut [f64],
     pts: [&PointData; 2],
     hess: [Option<&interface::Hessian>; 2],
@@ -456,6 +468,9 @@ fn add_segment<const FIRST: usize>(
                 continue;
             }
             f[dr] += g0 * fi[0] + g1 * fi[1];
+            let Some(k) = k.as_deref_mut() else {
+                continue;
+            };
             // Row r of G_iᵀ J_ij, times G_j.
             for (j, pj) in pts.iter().enumerate() {
                 let kj = &pj.kin;

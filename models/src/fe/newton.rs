@@ -35,6 +35,16 @@ pub const ROUND_OFF_FLOOR: f64 = 10.0;
 /// round-off floor.
 pub const ROUND_OFF_GAIN: f64 = 10.0;
 
+/// Residual, relative to the scale of the internal forces, below which the next correction
+/// reuses the last factorisation (a chord step) instead of assembling and factorising the tangent
+/// again. From there the tangent changes little between iterations, so a chord step contracts
+/// nearly as a Newton step does.
+pub(crate) const CHORD_BELOW: f64 = 1e-3;
+
+/// A chord step must divide the residual by at least `1 / CHORD_CONTRACTION`; otherwise the next
+/// correction is a full Newton step.
+pub(crate) const CHORD_CONTRACTION: f64 = 0.1;
+
 /// Why a step did not converge.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StepFailure {
@@ -74,6 +84,8 @@ pub struct Newton {
     pub active: usize,
     /// First node left out (`usize::MAX`: none); set with `active`.
     pub frozen_from_node: usize,
+    /// Under displacement control, chord steps below [`CHORD_BELOW`] (on by default).
+    pub(crate) chord: bool,
 }
 
 impl Newton {
@@ -103,9 +115,11 @@ impl Newton {
             safeguard: true,
             active: n,
             frozen_from_node: usize::MAX,
+            chord: true,
         }
     }
 
+    /// Assembles the internal forces, and the tangent into `k` with `tangent`.
     fn assemble(
         &mut self,
         p: &FeProblem,
@@ -113,10 +127,12 @@ impl Newton {
         states: &[LawState],
         q: &[f64],
         secant: bool,
+        tangent: bool,
     ) -> Result<(), StepFailure> {
         self.counters.0 += 1;
         self.asm.frozen_from_node = self.frozen_from_node;
-        if self.asm.assemble(p, law, states, q, &mut self.k, &mut self.f, secant) {
+        let k = tangent.then_some(&mut self.k);
+        if self.asm.assemble(p, law, states, q, k, &mut self.f, secant) {
             Ok(())
         } else {
             Err(StepFailure::NonFinite)
@@ -137,13 +153,29 @@ impl Newton {
         }
     }
 
+    /// Solves for the residual `r` in place with the last factors (a chord step), over the
+    /// unknowns they were made for.
+    fn solve_factored(&mut self) {
+        match self.lu.as_mut() {
+            Some(lu) => lu.solve_in_place(&mut self.r),
+            None => {
+                let n = self.k.n();
+                self.k.set_order(self.active);
+                self.k.solve_in_place(&mut self.r);
+                self.k.set_order(n);
+            }
+        }
+    }
+
     fn scale(&self) -> f64 {
         self.f.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300)
     }
 
     /// Solves for equilibrium with the control unknown held at `q[p.control]` (already set in the
     /// predictor `q`). On success `q` is the converged state, `self.f` its internal forces and
-    /// `self.asm.trial` its law results; returns the number of iterations.
+    /// `self.asm.trial` its law results; returns the number of corrections that factorised a
+    /// tangent (the chord steps between them are not counted: a step is as hard as the tangents
+    /// it needed, and the path's step control reads it so, as it did before chord steps).
     pub fn solve_displacement(
         &mut self,
         p: &FeProblem,
@@ -161,10 +193,17 @@ impl Newton {
         let mut secant_left = 0usize;
         let mut it = 0usize;
         let max_it = self.settings.max_iterations;
+        // Whether the next correction reuses the last factorisation (a chord step), and the
+        // residual of the last one that did.
+        let mut chord = false;
+        let mut chord_from = f64::INFINITY;
+        let mut chords = 0usize;
+        let mut chord_failed = false;
         while it <= max_it {
             let secant = secant_left > 0;
-            self.assemble(p, law, states, q, secant)?;
-            let tol = self.settings.tolerance * self.scale();
+            self.assemble(p, law, states, q, secant, !chord)?;
+            let scale = self.scale();
+            let tol = self.settings.tolerance * scale;
             let mut rmax = 0.0f64;
             for i in 0..q.len() {
                 let v = if self.fixed_mask[i] || i == p.control || i >= self.active { 0.0 } else { self.f[i] };
@@ -177,7 +216,7 @@ impl Newton {
             // Very stiff penalties make the residual's round-off floor exceed the tolerance; a
             // correction at round-off level with a small residual is then as converged as it gets.
             if rmax <= tol || (stalled && rmax <= 1e4 * tol) {
-                return Ok(it);
+                return Ok(it - chords);
             }
             if self.safeguard && rmax > r_prev && alpha > 0.3 {
                 alpha *= 0.5;
@@ -186,6 +225,7 @@ impl Newton {
                 }
                 secant_left = 4;
                 it += 1;
+                chord = false;
                 continue;
             }
             if it >= max_it {
@@ -195,16 +235,35 @@ impl Newton {
             secant_left = secant_left.saturating_sub(1);
             r_prev = rmax;
             alpha = 1.0;
-            for &d in &p.fixed {
-                self.k.set_identity_row_col(d);
+            let rel = rmax / scale;
+            if chord && rel > CHORD_CONTRACTION * chord_from {
+                // The chord does not contract: full Newton steps from here to the end of the step
+                // (the tangent was not assembled, so assemble again). Chord and Newton steps
+                // alternating would cycle where contact points change state (friction sticking
+                // and slipping).
+                chord = false;
+                chord_failed = true;
+                self.assemble(p, law, states, q, secant, true)?;
             }
-            self.k.set_identity_row_col(p.control);
-            self.counters.1 += 1;
-            let n = self.k.n();
-            self.k.set_order(self.active);
-            let factorized = self.factorize_and_solve(false);
-            self.k.set_order(n);
-            factorized.map_err(|_| StepFailure::Singular)?;
+            if chord {
+                chord_from = rel;
+                chords += 1;
+                self.solve_factored();
+            } else {
+                for &d in &p.fixed {
+                    self.k.set_identity_row_col(d);
+                }
+                self.k.set_identity_row_col(p.control);
+                self.counters.1 += 1;
+                let n = self.k.n();
+                self.k.set_order(self.active);
+                let factorized = self.factorize_and_solve(false);
+                self.k.set_order(n);
+                factorized.map_err(|_| StepFailure::Singular)?;
+            }
+            // The next correction reuses these factors where the residual is small, unless they
+            // are of a secant iteration matrix.
+            chord = self.chord && !chord_failed && rel <= CHORD_BELOW && !secant;
             let (mut dmax, mut qmax) = (0.0f64, 0.0f64);
             for ((qi, di), bi) in q.iter_mut().zip(&self.r).zip(self.b.iter_mut()) {
                 *qi += di;
@@ -236,7 +295,7 @@ impl Newton {
         let ic = p.control;
         let mut r_prev = f64::INFINITY;
         for it in 0..=self.settings.max_iterations {
-            self.assemble(p, law, states, q, false)?;
+            self.assemble(p, law, states, q, false, true)?;
             let tol = self.settings.tolerance * self.scale();
             let mut rmax = 0.0f64;
             for i in 0..q.len() {

@@ -61,6 +61,17 @@ pub fn run_with(
     s: &PathSettings,
     o: &RunOptions,
 ) -> Result<(Vec<StepRow>, RunStats), PathFailure> {
+    run_tuned(p, law, s, o, true)
+}
+
+/// [`run_with`], the whole mesh's chord steps on or off ([`Newton::chord`]).
+pub(crate) fn run_tuned(
+    p: &FeProblem,
+    law: &dyn CohesiveLaw,
+    s: &PathSettings,
+    o: &RunOptions,
+    chord: bool,
+) -> Result<(Vec<StepRow>, RunStats), PathFailure> {
     let (mut fallback, mut resume) = (None, None);
     if o.window && o.interface == InterfaceRule::Segments {
         match super::window::run(p, law, s) {
@@ -72,6 +83,7 @@ pub fn run_with(
         }
     }
     let mut run = WholeMesh::new(p, law, s, o, fallback);
+    run.nw.chord = chord;
     if !(s.target.is_finite() && s.target != 0.0 && s.outputs > 0) {
         return Err(run.fail("the path needs a finite, non-zero target and at least one output".into()));
     }
@@ -471,7 +483,7 @@ impl<'a> WholeMesh<'a> {
         if r.q.len() != self.cur.q.len() || r.states.len() != p.points.len() {
             return;
         }
-        if !self.nw.asm.assemble(p, law, &r.states, &r.q, &mut self.nw.k, &mut self.nw.f, false) {
+        if !self.nw.asm.assemble(p, law, &r.states, &r.q, Some(&mut self.nw.k), &mut self.nw.f, false) {
             return;
         }
         self.prev_q.copy_from_slice(&r.q);
@@ -814,10 +826,11 @@ impl<'a> WholeMesh<'a> {
         self.ledger.remap_points(&m.point_of, |i| {
             fresh[i].map_or((Traction::zeros(), Gap::zeros()), |(ev, g)| (ev.traction, g))
         });
-        let (counters, safeguard) = (self.nw.counters, self.nw.safeguard);
+        let (counters, safeguard, chord) = (self.nw.counters, self.nw.safeguard, self.nw.chord);
         self.nw = Newton::with_rule(p, law, self.s.newton, self.o.interface);
         self.nw.counters = counters;
         self.nw.safeguard = safeguard;
+        self.nw.chord = chord;
         self.measures = Measures::of(p);
         if let Some(old) = self.cut.take() {
             // The same cut on the new numbering (it only moves on).
@@ -960,5 +973,66 @@ fn tau_ratio_guard(forward: f64) -> f64 {
 impl From<StepFailure> for CzError {
     fn from(e: StepFailure) -> Self {
         CzError::Simulation(format!("{e:?}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dcb::{self, Dcb};
+    use crate::enf::Enf;
+    use crate::laws::Bilinear;
+    use crate::mmb::Mmb;
+
+    /// Chord steps on the whole mesh (the last factorisation reused once the residual is below
+    /// `CHORD_BELOW` of the forces) reach the states of full Newton steps, with fewer
+    /// factorisations: Hartlen's ENF-03 at its identified law, an MMB at G_II/G = 0.5 (the runs of
+    /// `benches/forward.rs`) and Hartlen's DCB-01 with large rotations to 15 mm.
+    #[test]
+    fn chord_steps_on_the_whole_mesh_reach_the_states_of_full_newton_steps() {
+        let mut enf = Enf::hartlen_enf03();
+        enf.mesh.interface_element = 0.25;
+        enf.mesh.interface_subdivision = 1;
+        enf.material.e11 = 34_106.0;
+        enf.control.max_displacement = Some(5.58);
+        let enf_law = Bilinear::bk(1e5, 30.0, 28.809, 0.8, 3.3386, 2.0).unwrap();
+        let (p, scale) = enf.problem(&enf_law).unwrap();
+        let enf_run = (p, enf.path(&enf_law, &scale), RunOptions::segments());
+
+        let mut mmb = Mmb::hartlen(43.722);
+        mmb.control.max_displacement = Some(7.0);
+        let mmb_law = Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).unwrap();
+        let (p, scale, lever) = mmb.build(&mmb_law).unwrap();
+        let mmb_run = (p, mmb.path(&mmb_law, &scale, lever), RunOptions::segments());
+
+        let mut d = Dcb::hartlen_dcb01();
+        d.effects.large_rotation = true;
+        d.control.max_displacement = Some(15.0);
+        let dcb_law = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
+        let (p, scale) = d.problem().unwrap();
+        let dcb_run = (p, d.path(&dcb_law, &scale), dcb::RUN_OPTIONS);
+
+        for (name, (p, path, options), law) in
+            [("ENF-03", enf_run, &enf_law), ("MMB", mmb_run, &mmb_law), ("DCB-01, large rotations", dcb_run, &dcb_law)]
+        {
+            let (newton, s_newton) = run_tuned(&p, law, &path, &options, false).unwrap();
+            let (chord, s_chord) = run_tuned(&p, law, &path, &options, true).unwrap();
+            assert!(!s_chord.windowed, "{name}: solved on the window");
+            assert_eq!(chord.len(), newton.len(), "{name}");
+            let peak = newton.iter().fold(0.0f64, |m, r| m.max(r.reaction.abs()));
+            let work = newton.iter().fold(0.0f64, |m, r| m.max(r.external_work.abs()));
+            let (mut load, mut energy) = (0.0f64, 0.0f64);
+            for (a, b) in chord.iter().zip(&newton) {
+                assert_eq!(a.control, b.control, "{name}");
+                load = load.max((a.reaction - b.reaction).abs() / peak);
+                energy = energy.max((a.elastic_energy - b.elastic_energy).abs() / work);
+                energy = energy.max((a.dissipated_energy - b.dissipated_energy).abs() / work);
+                energy = energy.max((a.external_work - b.external_work).abs() / work);
+            }
+            println!("{name}: loads within {load:.1e} of the peak, energies {energy:.1e} of the work; {s_chord:?} against {s_newton:?}");
+            assert!(load <= 1e-9, "{name}: loads differ by {load:e} of the peak");
+            assert!(energy <= 1e-9, "{name}: energies differ by {energy:e} of the work");
+            assert!(s_chord.factorizations < s_newton.factorizations, "{name}: {s_chord:?} against {s_newton:?}");
+        }
     }
 }

@@ -45,6 +45,7 @@ use super::crack::CrackMeasures;
 use super::energy::path_work;
 use super::interface::{self, PointKind, POINT_DOFS};
 use super::mesh::NONE;
+use super::newton::{CHORD_BELOW, CHORD_CONTRACTION};
 use super::pool::{self, Pooled};
 use super::run_types::{FrontTrack, PathSettings, Resume, RunStats, StepRow};
 use super::segment::{self, End, ModeOne, Segment};
@@ -64,15 +65,10 @@ const CHECK_DECAYS: f64 = 4.0;
 const CONDENSE_OPENING: f64 = 1.5;
 /// ... and it lies this many nodes behind the last such node.
 const CONDENSE_MARGIN: usize = 4;
-/// Residual (relative to the interface forces) below which the next correction reuses the last
-/// factorisation (a chord step) ... From there the tangent changes little between iterations, so
-/// a chord step contracts nearly as a Newton step does, and it spares the tangent's assembly and
-/// the block elimination: on the paper's DCB the step that takes the residual from about 10⁻⁸ to
-/// the tolerance is such a step, and a run factorises 222 times instead of 289.
-const CHORD_BELOW: f64 = 1e-3;
-/// ... as long as each chord step divides the residual by at least `1 / CHORD_CONTRACTION` (else
-/// the next correction is a full Newton step).
-const CHORD_CONTRACTION: f64 = 0.1;
+// Chord steps ([`CHORD_BELOW`], the residual relative to the interface forces here): they spare
+// the tangent's assembly and the block elimination; on the paper's DCB the step that takes the
+// residual from about 10⁻⁸ to the tolerance is such a step, and a run factorises 222 times
+// instead of 289.
 /// Node blocks: every node carries `D` unknowns, nodes with fewer padded with unknowns of unit
 /// stiffness coupled to nothing (they stay zero).
 type Blk<const D: usize> = [[f64; D]; D];
