@@ -106,6 +106,17 @@ struct State {
     work: Vec<f64>,
     bubbles: Vec<Vector4<f64>>,
     external: f64,
+    /// The step that led here, the predictor of the next one of the same control.
+    last: Option<LastStep>,
+}
+
+/// A converged step's change of the unknowns and of the applied displacement, per unit of its
+/// control's increment (the applied displacement's, or the front opening's).
+#[derive(Clone)]
+struct LastStep {
+    by_opening: bool,
+    du: Vec<f64>,
+    dd: f64,
 }
 
 struct Evaluation {
@@ -169,6 +180,7 @@ pub fn run(p: &ContinuumProblem, law: &dyn CohesiveLaw, settings: &PathSettings)
         work: vec![0.0; m],
         bubbles: vec![Vector4::zeros(); if p.large { ne } else { 0 }],
         external: 0.0,
+        last: None,
     };
     let mut rows = vec![s.row(&state)];
     let grid = settings.target / settings.outputs as f64;
@@ -303,6 +315,25 @@ impl Solver<'_> {
             Control::Displacement(to) => to,
             Control::Opening { .. } => st.delta,
         };
+        // The control's increment, and under large displacements the state extrapolated along
+        // the last step of the same control: the whole field moves, not the load point (or the
+        // front) alone. From the last state alone, a front-opening step of the total Lagrangian
+        // arms started with a residual ten times the load, which Newton's damped updates took 6
+        // to 18 iterations to bring down (the book's "Beam or continuum?"). In small strain
+        // Newton converges in a few iterations from the last state, and the runs are left as
+        // they were.
+        let (by_opening, increment) = match control {
+            Control::Displacement(to) => (false, to - st.delta),
+            Control::Opening { point, target } => (true, target - effective(&st.gaps[point])),
+        };
+        if let Some(last) = st.last.as_ref().filter(|l| self.p.large && l.by_opening == by_opening) {
+            for (v, r) in u.iter_mut().zip(&last.du) {
+                *v += r * increment;
+            }
+            if by_opening {
+                delta += last.dd * increment;
+            }
+        }
         let p0 = st.reaction;
         let mut current = self.evaluate(&mut u, delta, st, &control, true);
         // Relative residuals of the iterations so far, for the floor test.
@@ -322,7 +353,7 @@ impl Solver<'_> {
             let floor = !converged && self.accept_floor && constrained && at_floor(&history, self.settings.tolerance);
             if converged || floor {
                 self.stats.floor_steps += usize::from(floor);
-                return Ok(self.commit(st, u, delta, reaction, a));
+                return Ok(self.commit(st, u, delta, reaction, a, (by_opening, increment)));
             }
             if !norm.is_finite() {
                 return Err("the residual is not finite".into());
@@ -446,7 +477,15 @@ impl Solver<'_> {
         Ok((du, dd))
     }
 
-    fn commit(&mut self, st: &State, u: Vec<f64>, delta: f64, reaction: f64, a: Assembled) -> State {
+    fn commit(
+        &mut self,
+        st: &State,
+        u: Vec<f64>,
+        delta: f64,
+        reaction: f64,
+        a: Assembled,
+        (by_opening, increment): (bool, f64),
+    ) -> State {
         self.stats.steps += 1;
         let work: Vec<f64> = self
             .p
@@ -458,8 +497,14 @@ impl Solver<'_> {
                 st.work[i] + 0.5 * (st.tractions[i] + a.interface.tractions[i]).dot(&dg) * pt.area * pt.factor()
             })
             .collect();
+        let last = (self.p.large && increment.abs() > 0.0).then(|| LastStep {
+            by_opening,
+            du: u.iter().zip(&st.u).map(|(a, b)| (a - b) / increment).collect(),
+            dd: (delta - st.delta) / increment,
+        });
         State {
             external: st.external + 0.5 * (st.reaction + reaction) * (delta - st.delta),
+            last,
             u,
             delta,
             reaction,
