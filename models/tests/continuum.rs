@@ -127,6 +127,41 @@ fn paper_dcb_peak_matches_corrected_beam_theory_and_energy_balances() {
     assert!((load / branch - 1.0).abs() < 0.03, "load {load} N at {delta} mm vs corrected beam theory {branch} N");
 }
 
+/// How a run follows a running crack: its factorisations a step, the crack grown (mm), and its
+/// loads against a run with four times as many recorded states, read at this run's states
+/// (relative to the peak, sorted).
+struct PathCheck {
+    stats: czid_models::continuum::path::Stats,
+    per_step: f64,
+    grown: f64,
+    differences: Vec<f64>,
+}
+
+fn follow(dcb: &Dcb2d, law: &Bilinear) -> PathCheck {
+    let (r, stats) = dcb.simulate_with_stats(law).unwrap();
+    let per_step = stats.factorisations as f64 / stats.steps as f64;
+    let grown = *r.column(columns::DEBONDED_LENGTH).unwrap().last().unwrap();
+    let mut fine = dcb.clone();
+    fine.control.output_points *= 4;
+    let f = fine.simulate(law).unwrap();
+    let (d, p) = (r.column(columns::DISPLACEMENT).unwrap(), r.column(columns::LOAD).unwrap());
+    let (df, pf) = (f.column(columns::DISPLACEMENT).unwrap(), f.column(columns::LOAD).unwrap());
+    let top = peak(&r).0;
+    let end = df[df.len() - 1];
+    let mut differences: Vec<f64> =
+        d.iter().zip(p).filter(|(&x, _)| x <= end).map(|(&x, &y)| (load_at(df, pf, x) - y).abs() / top).collect();
+    differences.sort_by(f64::total_cmp);
+    eprintln!(
+        "{} steps, {per_step:.1} factorisations a step, crack grown {grown:.1} mm; loads at {} states vs a run with {} states: median difference {:.2e}, worst {:.2e} of the peak",
+        stats.steps,
+        d.len(),
+        df.len(),
+        differences[differences.len() / 2],
+        differences[differences.len() - 1]
+    );
+    PathCheck { stats, per_step, grown, differences }
+}
+
 /// While the crack runs, cohesive points cross the onset and the unloading kinks of their law in
 /// every step. Newton with a residual-guided line search used to crawl there (10–19 iterations a
 /// step, a third of the steps cut after 20): short updates kept the points on the wrong side of
@@ -136,37 +171,12 @@ fn paper_dcb_peak_matches_corrected_beam_theory_and_energy_balances() {
 fn a_running_crack_costs_a_few_newton_iterations_per_step_and_the_steps_do_not_move_the_path() {
     let mut dcb = Dcb2d::paper();
     dcb.control.max_displacement = Some(15.0);
-    let law = Bilinear::bk(1e5, 15.0, 15.0, 0.57, 2.0, 2.0).unwrap();
-    let (r, stats) = dcb.simulate_with_stats(&law).unwrap();
-    let per_step = stats.factorisations as f64 / stats.steps as f64;
-    let grown = *r.column(columns::DEBONDED_LENGTH).unwrap().last().unwrap();
-    eprintln!(
-        "paper DCB to 15 mm: {} steps, {per_step:.1} factorisations a step, crack grown {grown:.1} mm",
-        stats.steps
-    );
-    assert!(grown > 20.0, "the crack grew {grown} mm");
-    assert!(per_step <= 12.0, "{per_step} factorisations a step ({stats:?})");
+    let c = follow(&dcb, &Bilinear::bk(1e5, 15.0, 15.0, 0.57, 2.0, 2.0).unwrap());
+    assert!(c.grown > 20.0, "the crack grew {} mm", c.grown);
+    assert!(c.per_step <= 12.0, "{} factorisations a step ({:?})", c.per_step, c.stats);
     // A path that converges at the tolerance never needs the round-off floor.
-    assert_eq!(stats.floor_steps, 0, "{stats:?}");
-    let mut fine = dcb.clone();
-    fine.control.output_points *= 4;
-    let f = fine.simulate(&law).unwrap();
-    let (d, p) = (r.column(columns::DISPLACEMENT).unwrap(), r.column(columns::LOAD).unwrap());
-    let (df, pf) = (f.column(columns::DISPLACEMENT).unwrap(), f.column(columns::LOAD).unwrap());
-    let top = peak(&r).0;
-    let end = df[df.len() - 1];
-    let worst = d
-        .iter()
-        .zip(p)
-        .filter(|(&x, _)| x <= end)
-        .map(|(&x, &y)| (load_at(df, pf, x) - y).abs() / top)
-        .fold(0.0, f64::max);
-    eprintln!(
-        "loads at {} states vs a run with {} states: worst difference {:.2e} of the peak",
-        d.len(),
-        df.len(),
-        worst
-    );
+    assert_eq!(c.stats.floor_steps, 0, "{:?}", c.stats);
+    let worst = c.differences[c.differences.len() - 1];
     assert!(worst < 2e-3, "worst difference {worst} of the peak");
 }
 
@@ -184,33 +194,11 @@ fn a_running_crack_under_large_displacements_costs_a_few_newton_iterations_per_s
     let mut dcb = Dcb2d::hartlen_dcb01();
     dcb.effects.large_rotation = true;
     dcb.control.max_displacement = Some(20.0);
-    let law = Bilinear::bk(1e5, 60.0, 60.0, 0.8, 2.0, 2.0).unwrap();
-    let (r, stats) = dcb.simulate_with_stats(&law).unwrap();
-    let per_step = stats.factorisations as f64 / stats.steps as f64;
-    let grown = *r.column(columns::DEBONDED_LENGTH).unwrap().last().unwrap();
-    eprintln!(
-        "Hartlen DCB-01, large displacements, to 20 mm: {} steps, {per_step:.1} factorisations a step, crack grown {grown:.1} mm",
-        stats.steps
-    );
-    assert!(grown > 30.0, "the crack grew {grown} mm");
-    assert!(per_step <= 10.0, "{per_step} factorisations a step ({stats:?})");
-    assert_eq!(stats.floor_steps, 0, "{stats:?}");
-    let mut fine = dcb.clone();
-    fine.control.output_points *= 4;
-    let f = fine.simulate(&law).unwrap();
-    let (d, p) = (r.column(columns::DISPLACEMENT).unwrap(), r.column(columns::LOAD).unwrap());
-    let (df, pf) = (f.column(columns::DISPLACEMENT).unwrap(), f.column(columns::LOAD).unwrap());
-    let top = peak(&r).0;
-    let end = df[df.len() - 1];
-    let mut differences: Vec<f64> =
-        d.iter().zip(p).filter(|(&x, _)| x <= end).map(|(&x, &y)| (load_at(df, pf, x) - y).abs() / top).collect();
-    differences.sort_by(f64::total_cmp);
-    let (median, worst) = (differences[differences.len() / 2], differences[differences.len() - 1]);
-    eprintln!(
-        "loads at {} states vs a run with {} states: median difference {median:.2e}, worst {worst:.2e} of the peak",
-        d.len(),
-        df.len()
-    );
+    let c = follow(&dcb, &Bilinear::bk(1e5, 60.0, 60.0, 0.8, 2.0, 2.0).unwrap());
+    assert!(c.grown > 30.0, "the crack grew {} mm", c.grown);
+    assert!(c.per_step <= 10.0, "{} factorisations a step ({:?})", c.per_step, c.stats);
+    assert_eq!(c.stats.floor_steps, 0, "{:?}", c.stats);
+    let (median, worst) = (c.differences[c.differences.len() / 2], c.differences[c.differences.len() - 1]);
     assert!(median < 3e-3 && worst < 1e-2, "median {median}, worst {worst} of the peak");
 }
 
