@@ -73,16 +73,9 @@ fn forward(c: &mut Criterion) {
     let hartlen = Dcb::hartlen_dcb01();
     let law = Bilinear::bk(1e5, 30.0, 40.0, 0.8, 1.6, 2.0).unwrap();
     g.bench_function("dcb_hartlen_30mm", |b| b.iter(|| hartlen.simulate(&law).unwrap()));
-    let mut enf = Enf::hartlen_enf03();
-    enf.mesh.interface_element = 0.25;
-    enf.mesh.interface_subdivision = 1;
-    enf.material.e11 = 34_106.0;
-    enf.control.max_displacement = Some(5.58);
-    let mode_two = Bilinear::bk(1e5, 30.0, 28.809, 0.8, 3.3386, 2.0).unwrap();
+    let (enf, mode_two) = Enf::hartlen_enf03_identified();
     g.bench_function("enf_hartlen03_identified", |b| b.iter(|| enf.simulate(&mode_two).unwrap()));
-    let mut mmb = Mmb::hartlen(43.722);
-    mmb.control.max_displacement = Some(7.0);
-    let mixed = Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).unwrap();
+    let (mmb, mixed) = Mmb::hartlen_half_mode_two();
     g.bench_function("mmb_hartlen_half_mode_two", |b| b.iter(|| mmb.simulate(&mixed).unwrap()));
     g.finish();
     // Large rotations: the co-rotational beams run on the whole mesh, 0.3–0.6 s a run.

@@ -47,15 +47,8 @@ fn main() {
 
 /// The ENF and MMB cases (whole-mesh solves).
 fn split_beam(case: &str, runs: usize) {
-    let mut e = Enf::hartlen_enf03();
-    e.mesh.interface_element = 0.25;
-    e.mesh.interface_subdivision = 1;
-    e.material.e11 = 34_106.0;
-    e.control.max_displacement = Some(5.58);
-    let enf_law = Bilinear::bk(1e5, 30.0, 28.809, 0.8, 3.3386, 2.0).unwrap();
-    let mut m = Mmb::hartlen(43.722);
-    m.control.max_displacement = Some(7.0);
-    let mmb_law = Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).unwrap();
+    let (e, enf_law) = Enf::hartlen_enf03_identified();
+    let (m, mmb_law) = Mmb::hartlen_half_mode_two();
     let run = || {
         if case == "enf" {
             e.simulate(&enf_law).unwrap();

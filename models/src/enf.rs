@@ -76,6 +76,20 @@ impl Enf {
         }
     }
 
+    /// ENF-03 as `examples/hartlen-enf/enf03.toml` runs it (0.25 mm interface elements of one
+    /// beam element each, to 5.58 mm), at the flexural modulus and the bilinear law that file
+    /// identifies (σ_t 28.809 MPa, G_IIc 3.3386 N/mm, E11 34 106 MPa): the mode II run the speed
+    /// figures of the book's *Mixed mode* chapter and `benches/forward.rs` are measured on.
+    pub fn hartlen_enf03_identified() -> (Self, crate::laws::Bilinear) {
+        let mut enf = Enf::hartlen_enf03();
+        enf.mesh.interface_element = 0.25;
+        enf.mesh.interface_subdivision = 1;
+        enf.material.e11 = 34_106.0;
+        enf.control.max_displacement = Some(5.58);
+        let law = crate::laws::Bilinear::bk(1e5, 30.0, 28.809, 0.8, 3.3386, 2.0).expect("a valid law");
+        (enf, law)
+    }
+
     /// Checks the configuration, naming the first invalid field.
     pub fn validate(&self) -> Result<()> {
         beamtest::positive(OWNER, "a0", self.a0)?;

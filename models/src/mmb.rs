@@ -102,6 +102,16 @@ impl Mmb {
         }
     }
 
+    /// The MMB the book's *Mixed mode* speed figures and `benches/forward.rs` are measured on:
+    /// [`Mmb::hartlen`] with a 43.722 mm lever (G_II/G = 0.5) to 7 mm, and a bilinear law of
+    /// σ_n 25, σ_t 35 MPa, G_Ic 0.8, G_IIc 3 N/mm, η 2.2.
+    pub fn hartlen_half_mode_two() -> (Self, crate::laws::Bilinear) {
+        let mut mmb = Mmb::hartlen(43.722);
+        mmb.control.max_displacement = Some(7.0);
+        let law = crate::laws::Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).expect("a valid law");
+        (mmb, law)
+    }
+
     /// The lever length that gives the mode ratio `G_II/G = psi` by beam theory (inverse of
     /// [`Mmb::beam_mode_ratio`], `0 < psi ≤ 1`; `psi = 1` gives `c = L/3`).
     pub fn lever_for_mode_ratio(half_span: f64, psi: f64) -> f64 {

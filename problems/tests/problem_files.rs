@@ -598,3 +598,18 @@ fn overrides_reach_the_one_model_of_a_model_file() {
     let e = LoadedProblem::read_with(&dir.join("problem.toml"), &set("model.a0", "1")).unwrap_err().to_string();
     assert!(e.contains("no top-level [model]"), "{e}");
 }
+
+/// The ENF-03 run of the speed figures (`Enf::hartlen_enf03_identified`) is the example file's
+/// model at the modulus it identifies: the same specimen, mesh and end of the test.
+#[test]
+fn the_enf03_speed_run_is_the_example_files_model() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/hartlen-enf/enf03.toml");
+    let problem = LoadedProblem::read(&file).unwrap();
+    let from_file = serde_json::to_value(&*problem.file.experiment[0].model).unwrap();
+    let (mut run, _) = czid_models::enf::Enf::hartlen_enf03_identified();
+    run.material.e11 = from_file["material"]["e11"].as_f64().unwrap();
+    let built = serde_json::to_value(&run as &dyn ForwardModel).unwrap();
+    for field in ["a0", "half_span", "width", "h", "material", "mesh", "control", "effects"] {
+        assert_eq!(from_file[field], built[field], "`{field}` of examples/hartlen-enf/enf03.toml");
+    }
+}

@@ -990,18 +990,11 @@ mod tests {
     /// `benches/forward.rs`) and Hartlen's DCB-01 with large rotations to 15 mm.
     #[test]
     fn chord_steps_on_the_whole_mesh_reach_the_states_of_full_newton_steps() {
-        let mut enf = Enf::hartlen_enf03();
-        enf.mesh.interface_element = 0.25;
-        enf.mesh.interface_subdivision = 1;
-        enf.material.e11 = 34_106.0;
-        enf.control.max_displacement = Some(5.58);
-        let enf_law = Bilinear::bk(1e5, 30.0, 28.809, 0.8, 3.3386, 2.0).unwrap();
+        let (enf, enf_law) = Enf::hartlen_enf03_identified();
         let (p, scale) = enf.problem(&enf_law).unwrap();
         let enf_run = (p, enf.path(&enf_law, &scale), RunOptions::segments());
 
-        let mut mmb = Mmb::hartlen(43.722);
-        mmb.control.max_displacement = Some(7.0);
-        let mmb_law = Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).unwrap();
+        let (mmb, mmb_law) = Mmb::hartlen_half_mode_two();
         let (p, scale, lever) = mmb.build(&mmb_law).unwrap();
         let mmb_run = (p, mmb.path(&mmb_law, &scale, lever), RunOptions::segments());
 
