@@ -93,7 +93,7 @@ fn linear_branch_compliance_matches_the_superposed_beam_solution() {
 fn dissipated_mode_ratio(m: &Mmb, k: f64) -> (f64, f64, f64) {
     // Equal toughness in both modes: the partition is the loading's, not the law's.
     let law = TestBilinear::new(k, 30.0, 1.0);
-    let (rows, _) = m.run_rows(&law).unwrap_or_else(|f| panic!("{}", f.error));
+    let (rows, _) = m.run_rows_whole_mesh(&law).unwrap_or_else(|f| panic!("{}", f.error));
     let crack = |r: &czid_models::fe::StepRow| r.crack.debonded;
     let first = rows.iter().position(|r| crack(r) >= 2.0).expect("the crack grew 2 mm");
     let last = rows.iter().rposition(|r| crack(r) <= 8.0).unwrap();

@@ -25,7 +25,8 @@
 //! * **Window.** With [`RunOptions::window`] a problem that fits is solved by `fe::window`
 //!   (displacement control on the unknowns around the crack front only); anything else, and any
 //!   run the window gives up on, by the whole-mesh solver here, which goes on from the window's
-//!   last committed state when the window gave up part way.
+//!   last committed state when the window gave up part way (and starts again from rest if it
+//!   cannot go on from there: the window never fails a run the whole mesh completes).
 //! * A run that still fails returns the error and every row that converged.
 
 use std::rc::Rc;
@@ -82,6 +83,26 @@ pub(crate) fn run_tuned(
             Err((why, state)) => (fallback, resume) = (Some(why.reason()), state),
         }
     }
+    let resumed = resume.is_some();
+    match whole_mesh(p, law, s, o, chord, fallback, resume) {
+        // Where the whole mesh cannot go on from the window's state (a path through a snap-back
+        // that its own steps from rest would have taken otherwise), it starts again from rest: the
+        // window never makes a run fail that the whole mesh completes.
+        Err(_) if resumed => whole_mesh(p, law, s, o, chord, fallback, None),
+        done => done,
+    }
+}
+
+/// The whole-mesh solve of [`run_tuned`], from rest or from the state a windowed run reached.
+fn whole_mesh(
+    p: &FeProblem,
+    law: &dyn CohesiveLaw,
+    s: &PathSettings,
+    o: &RunOptions,
+    chord: bool,
+    fallback: Option<&'static str>,
+    resume: Option<Box<Resume>>,
+) -> Result<(Vec<StepRow>, RunStats), PathFailure> {
     let mut run = WholeMesh::new(p, law, s, o, fallback);
     run.nw.chord = chord;
     if !(s.target.is_finite() && s.target != 0.0 && s.outputs > 0) {

@@ -14,6 +14,16 @@
 //! window's unknowns only, and the result is the solution of the whole problem — exactly, not an
 //! approximation — as long as the points of `L` and `R` are what their region assumes.
 //!
+//! **A control ahead of the crack.** A specimen loaded away from its cracked end (a mixed-mode
+//! bending test: supports at both ends, the lever's saddle at mid-span, ahead of the front) has
+//! the control unknown coupled to one node of the interface, and supports inside the regions.
+//! Supports only leave their nodes with fewer unknowns. The control's column is carried by
+//! whichever region holds its node: in `R` the elimination gives `q_{j+1} = T_{j+1} q_j +
+//! t_{j+1} c` and the control's force from `R` as `a·q_{i1} + s c` on the window's last node, in
+//! the window it is a term of the residual, and in `L` it is eliminated as the DCB's. The cracked
+//! faces' contact points behind the interface belong to `L`, where open faces carry nothing;
+//! that they stay open is checked like the failed points'.
+//!
 //! **Checks.** That is verified, not assumed: the law's response is checked to be `K₀ g` over a box
 //! of gaps containing the origin (its corners, the elastic domain being convex) and zero for failed
 //! material in opening; after every step the unknowns of `R` and `L` are recovered over
@@ -31,7 +41,8 @@
 //! independent of the specimen's length.
 //!
 //! **Energies** of `L` and `R` follow from Clapeyron's theorem: a linear substructure loaded only
-//! at its boundary stores half the work of the boundary forces on the boundary displacements.
+//! at its boundary stores half the work of the boundary forces on the boundary displacements (the
+//! control among them, with each region's share of its force).
 
 use std::any::Any;
 use std::cell::RefCell;
@@ -134,6 +145,7 @@ fn zb<const D: usize>() -> Blk<D> {
     [[0.0; D]; D]
 }
 
+#[inline(always)]
 fn blk_mul<const D: usize>(a: &Blk<D>, b: &Blk<D>) -> Blk<D> {
     let mut o = zb::<D>();
     for i in 0..D {
@@ -147,6 +159,7 @@ fn blk_mul<const D: usize>(a: &Blk<D>, b: &Blk<D>) -> Blk<D> {
     o
 }
 
+#[inline(always)]
 fn blk_vec<const D: usize>(a: &Blk<D>, v: &Vct<D>) -> Vct<D> {
     let mut o = [0.0; D];
     for i in 0..D {
@@ -210,6 +223,7 @@ impl<const D: usize> Lu<D> {
         Some(Lu { m, perm })
     }
 
+    #[inline(always)]
     fn solve(&self, b: &Vct<D>) -> Vct<D> {
         let mut x = [0.0; D];
         for i in 0..D {
@@ -266,6 +280,13 @@ struct Layout<const D: usize> {
     /// Coupling of each node's unknowns to the control unknown, and its own diagonal.
     kc: Vec<Vct<D>>,
     kcc: f64,
+    /// The nodes the control unknown couples to where they are not behind the interface's first
+    /// node (the load point of a beam on two supports, ahead of the crack), first and last: the
+    /// condensed right region and the window then carry the control's column too.
+    control_nodes: Option<(usize, usize)>,
+    /// Contact points of the cracked faces before the interface chain (node, gap gradient): open
+    /// faces carry nothing, so they belong to the left region while they stay open.
+    contacts: Vec<(usize, ChainPoint<D>)>,
 }
 
 /// Each node's unknowns, each unknown's (node, position in the node), and which are fixed.
@@ -277,8 +298,8 @@ fn node_dofs(p: &FeProblem) -> Result<Numbering, Unfit> {
     if p.large_rotation {
         return Err(Unfit::Structure("large rotations (the beams are not linear)"));
     }
-    if p.points.iter().any(|pt| pt.kind != PointKind::Cohesive) {
-        return Err(Unfit::Structure("contact points"));
+    if p.contact_friction != 0.0 && p.points.iter().any(|pt| pt.kind != PointKind::Cohesive) {
+        return Err(Unfit::Structure("frictional contact points"));
     }
     let nn = mesh.x.len();
     let mut fixed = vec![false; mesh.n_dofs()];
@@ -308,15 +329,8 @@ fn node_dofs(p: &FeProblem) -> Result<Numbering, Unfit> {
         }
         nodes.push(nd);
     }
-    // The control unknown and the supports must sit at the loaded end (nodes 0 and 1, or an
-    // extra unknown).
-    let node_of = |g: usize| (0..nn).find(|&i| (0..mesh.layers.len()).any(|l| mesh.dofs(l, i).contains(&g)));
-    if node_of(c).is_some_and(|i| i > 0) {
-        return Err(Unfit::Structure("control unknown away from the loaded end"));
-    }
-    if p.fixed.iter().any(|&f| node_of(f).is_some_and(|i| i > 1)) {
-        return Err(Unfit::Structure("supports away from the loaded end"));
-    }
+    // Supports anywhere leave their nodes with fewer unknowns; where the control unknown may sit
+    // is checked on the stiffness ([`Layout::new`]).
     Ok((nodes, owner, fixed))
 }
 
@@ -327,7 +341,8 @@ impl<const D: usize> Layout<D> {
         let c = p.control;
         // One chain of segments over consecutive nodes.
         let (segs, _) = segment::segments(mesh, &p.points);
-        if segs.is_empty() || segs.len() + 1 != p.points.len() {
+        let cohesive = p.points.iter().filter(|pt| pt.kind == PointKind::Cohesive).count();
+        if segs.is_empty() || segs.len() + 1 != cohesive {
             return Err(Unfit::Structure("the cohesive points do not form one chain of segments"));
         }
         let first = p.points[segs[0].a].node;
@@ -343,11 +358,9 @@ impl<const D: usize> Layout<D> {
         if first < 2 || last != nn - 1 {
             return Err(Unfit::Structure("the interface must run from beyond the loaded end to the far end"));
         }
-        let mut chain = Vec::with_capacity(segs.len() + 1);
         let mut hess = [[[0.0; POINT_DOFS]; POINT_DOFS]; 2];
         let zero = vec![0.0; mesh.n_dofs()];
-        for k in 0..=segs.len() {
-            let pi = if k < segs.len() { segs[k].a } else { segs[k - 1].b };
+        let mut chain_point = |pi: usize| -> Result<ChainPoint<D>, Unfit> {
             let pt = &p.points[pi];
             let kin = interface::kinematics(mesh, pt, &zero, false, &mut hess);
             let mut grad = [[0.0; D]; 2];
@@ -363,8 +376,22 @@ impl<const D: usize> Layout<D> {
                     grad[r][local] = kin.grad[r][j];
                 }
             }
-            chain.push(ChainPoint { point: pi, grad, weight: pt.area * pt.factor });
+            Ok(ChainPoint { point: pi, grad, weight: pt.area * pt.factor })
+        };
+        let mut chain = Vec::with_capacity(segs.len() + 1);
+        for k in 0..=segs.len() {
+            chain.push(chain_point(if k < segs.len() { segs[k].a } else { segs[k - 1].b })?);
         }
+        let mut contacts = Vec::new();
+        for (pi, pt) in p.points.iter().enumerate() {
+            if pt.kind == PointKind::Contact {
+                if pt.node > first {
+                    return Err(Unfit::Structure("contact points ahead of the interface's first node"));
+                }
+                contacts.push((pt.node, chain_point(pi)?));
+            }
+        }
+        contacts.sort_by_key(|(node, _)| *node);
         // Linear stiffness blocks: beams and springs, scattered by node. Only the rows of node
         // unknowns are kept for the control unknown's coupling (the matrix is symmetric).
         let mut lay = Layout {
@@ -379,6 +406,8 @@ impl<const D: usize> Layout<D> {
             ed1: vec![zb::<D>(); nn],
             kc: vec![[0.0; D]; nn],
             kcc: 0.0,
+            control_nodes: None,
+            contacts,
         };
         for (i, nd) in nodes.iter().enumerate() {
             for a in nd.d..D {
@@ -477,14 +506,24 @@ impl<const D: usize> Layout<D> {
                 put(&mut lay, sp.j, sp.i, -sp.k * sp.ci, None)?;
             }
         }
-        if lay.kc.iter().skip(2).any(|v| v.iter().any(|x| *x != 0.0)) {
-            return Err(Unfit::Structure("the control unknown couples beyond the first two nodes"));
+        // The control couples to nodes behind the interface (a DCB's loaded end: the left region
+        // holds them all run long), or to nodes along it (each carried by whichever region holds
+        // it).
+        let coupled = |j: &usize| lay.kc[*j].iter().any(|x| *x != 0.0);
+        if let (Some(a), Some(b)) = ((first..nn).find(coupled), (first..nn).rev().find(coupled)) {
+            lay.control_nodes = Some((a, b));
         }
         Ok(lay)
     }
 
     fn cp(&self, node: usize) -> &ChainPoint<D> {
         &self.chain[node - self.first]
+    }
+
+    /// Whether the contact points at `node` (if any) are open at its unknowns `q`.
+    fn contacts_open(&self, node: usize, q: &Vct<D>) -> bool {
+        let from = self.contacts.partition_point(|(n, _)| *n < node);
+        self.contacts[from..].iter().take_while(|(n, _)| *n == node).all(|(_, cp)| gap_at(cp, q)[0] >= 0.0)
     }
 }
 
@@ -639,6 +678,7 @@ fn run_tuned(
         3 => with!(3),
         4 => with!(4),
         6 => with!(6),
+        7 => with!(7),
         _ => with!(8),
     }
 }
@@ -672,6 +712,7 @@ fn prepared(p: &FeProblem) -> Result<(usize, Rc<dyn Any>), Unfit> {
         3 => 3,
         4 => 4,
         5 | 6 => 6,
+        7 => 7,
         _ => 8,
     };
     let layout: Rc<dyn Any> = match d {
@@ -679,6 +720,7 @@ fn prepared(p: &FeProblem) -> Result<(usize, Rc<dyn Any>), Unfit> {
         3 => Rc::new(Layout::<3>::new(p, &nodes, &owner, &fixed)?),
         4 => Rc::new(Layout::<4>::new(p, &nodes, &owner, &fixed)?),
         6 => Rc::new(Layout::<6>::new(p, &nodes, &owner, &fixed)?),
+        7 => Rc::new(Layout::<7>::new(p, &nodes, &owner, &fixed)?),
         _ => Rc::new(Layout::<8>::new(p, &nodes, &owner, &fixed)?),
     };
     LAYOUTS.with(|c| {
@@ -701,8 +743,14 @@ struct Solver<'a, const D: usize> {
     /// Elastic segment blocks (segment k between nodes first + k and first + k + 1).
     es_aa: Pooled<Blk<D>>,
     es_ab: Pooled<Blk<D>>,
-    /// Right region: `q_{j} = tr[j] q_{j−1}` for j > i1.
+    /// Right region: `q_{j} = tr[j] q_{j−1} + trc[j] c` for j > i1, and the control's force from
+    /// nodes `j` on, `ra[j]·q_{j−1} + rs[j] c` (`trc`, `ra`, `rs` zero unless the control couples
+    /// to nodes of the interface, [`Layout::control_nodes`]; `ra`, `rs` have a zero entry past the
+    /// last node).
     tr: Pooled<Blk<D>>,
+    trc: Pooled<Vct<D>>,
+    ra: Pooled<Vct<D>>,
+    rs: Pooled<f64>,
     /// Left region: `q_j = tl[j] q_{j+1} + tlc[j] c` for j < i0, and the eliminated state.
     tl: Pooled<Blk<D>>,
     tlc: Pooled<Vct<D>>,
@@ -786,9 +834,14 @@ impl<'a, const D: usize> Solver<'a, D> {
             put(&mut es_ba[k], gb, ga, 1.0 / 6.0);
             put(&mut es_bb[k], gb, gb, 1.0 / 3.0);
         }
-        // Right region, eliminated from the far end: q_j = tr[j] q_{j−1}.
+        // Right region, eliminated from the far end: q_j = tr[j] q_{j−1} (+ trc[j] c).
         let mut tr = pool::take(nn, zb::<D>());
+        let with_control = lay.control_nodes.is_some();
+        let mut trc = pool::take(if with_control { nn } else { 0 }, [0.0; D]);
+        let mut ra = pool::take(if with_control { nn + 1 } else { 0 }, [0.0; D]);
+        let mut rs = pool::take(if with_control { nn + 1 } else { 0 }, 0.0);
         let mut next: Option<Blk<D>> = None; // E_{j,j+1} tr[j+1]
+        let mut next_c = [0.0; D]; // E_{j,j+1} trc[j+1]
         for j in (lay.first + 1..=lay.last).rev() {
             let mut dd = lay.kd[j];
             let k = j - lay.first; // segment k − 1 ends at j, segment k starts at j
@@ -809,6 +862,27 @@ impl<'a, const D: usize> Solver<'a, D> {
             let mut e_up = lay.ku[j - 1];
             add(&mut e_up, &es_ab[k - 1]);
             next = Some(blk_mul(&e_up, &tr[j]));
+            if with_control {
+                // trc[j] = −M⁻¹ (k_c,j + E_{j,j+1} trc[j+1]); the control's force from nodes j on,
+                // k_c,j·q_j + ra[j+1]·q_j + rs[j+1] c, with q_j substituted.
+                let mut e = lay.kc[j];
+                addv(&mut e, &next_c);
+                let tc = lu.solve(&e);
+                for a in 0..D {
+                    trc[j][a] = -tc[a];
+                }
+                next_c = blk_vec(&e_up, &trc[j]);
+                let mut f = lay.kc[j];
+                addv(&mut f, &ra[j + 1]);
+                let mut r = [0.0; D];
+                for b in 0..D {
+                    for a in 0..D {
+                        r[b] += f[a] * tr[j][a][b];
+                    }
+                }
+                ra[j] = r;
+                rs[j] = rs[j + 1] + dot(&f, &trc[j]);
+            }
         }
         // Decay length: the upper layer's EI against the normal interface stiffness per unit
         // length of a typical segment.
@@ -839,6 +913,9 @@ impl<'a, const D: usize> Solver<'a, D> {
             es_aa,
             es_ab,
             tr,
+            trc,
+            ra,
+            rs,
             tl: pool::take(nn, zb::<D>()),
             tlc: pool::take(nn, [0.0; D]),
             rho: [0.0; D],
@@ -935,7 +1012,21 @@ impl<'a, const D: usize> Solver<'a, D> {
 
     /// Unknowns of the right region's node `j` (`j > i1`) from those of node `j − 1`.
     fn right_value(&self, j: usize, prev: &Vct<D>) -> Vct<D> {
-        blk_vec(&self.tr[j], prev)
+        let mut v = blk_vec(&self.tr[j], prev);
+        if let Some(tc) = self.trc.get(j) {
+            for a in 0..D {
+                v[a] += tc[a] * self.c;
+            }
+        }
+        v
+    }
+
+    /// The control's force from the right region (nodes after `i1`), `ra·q_{i1} + rs c`.
+    fn right_control_force(&self) -> f64 {
+        match (self.ra.get(self.i1 + 1), self.rs.get(self.i1 + 1)) {
+            (Some(ra), Some(rs)) => dot(ra, &self.q[self.i1]) + rs * self.c,
+            _ => 0.0,
+        }
     }
 
     fn gap(&self, node: usize, q: &Vct<D>) -> Gap {
@@ -951,6 +1042,8 @@ impl<'a, const D: usize> Solver<'a, D> {
         // Linear parts.
         for j in i0..=i1 {
             let mut a = lay.kd[j];
+            // The control's column at node j: its own coupling, or the right region's through it.
+            let mut ctl = None;
             if j == i1 && j < lay.last {
                 let k = j - lay.first;
                 add(&mut a, &self.es_aa[k]);
@@ -958,6 +1051,14 @@ impl<'a, const D: usize> Solver<'a, D> {
                 add(&mut e_up, &self.es_ab[k]);
                 let s = blk_mul(&e_up, &self.tr[j + 1]);
                 add(&mut a, &s);
+                if let Some(tc) = self.trc.get(j + 1) {
+                    ctl = Some(blk_vec(&e_up, tc));
+                }
+            }
+            if j > i0 && lay.control_nodes.is_some_and(|(a, b)| a <= j && j <= b) {
+                let mut v = ctl.unwrap_or([0.0; D]);
+                addv(&mut v, &lay.kc[j]);
+                ctl = Some(v);
             }
             if j == i0 {
                 let s = blk_mul(&lay.kl[j - 1], &self.tl[j - 1]);
@@ -983,6 +1084,11 @@ impl<'a, const D: usize> Solver<'a, D> {
                 let v = blk_vec(&lay.kl[j - 1], &self.tlc[j - 1]);
                 for a in 0..D {
                     r[a] += (v[a] + lay.kc[j][a]) * self.c;
+                }
+            }
+            if let Some(v) = ctl {
+                for a in 0..D {
+                    r[a] += v[a] * self.c;
                 }
             }
             self.res[j] = r;
@@ -1055,6 +1161,12 @@ impl<'a, const D: usize> Solver<'a, D> {
         let mut react = self.sigma * self.c;
         for a in 0..D {
             react += self.rho[a] * self.q[i0][a];
+        }
+        if let Some((a, b)) = lay.control_nodes {
+            for j in a.max(i0 + 1)..=b.min(i1) {
+                react += dot(&lay.kc[j], &self.q[j]);
+            }
+            react += self.right_control_force();
         }
         self.reaction = react;
         let mut rmax = 0.0f64;
@@ -1227,7 +1339,12 @@ impl<'a, const D: usize> Solver<'a, D> {
         let end = i1 + 1 + xs[i1 + 1..=lay.last].partition_point(|&x| x - xs[i1] <= zone);
         let (tr, chain) = (&self.tr[i1 + 1..end], &lay.chain[i1 + 1 - lay.first..end - lay.first]);
         for (j, (t, cp)) in (i1 + 1..end).zip(tr.iter().zip(chain)) {
-            let v = blk_vec(t, &prev);
+            let mut v = blk_vec(t, &prev);
+            if let Some(tc) = self.trc.get(j) {
+                for a in 0..D {
+                    v[a] += tc[a] * self.c;
+                }
+            }
             let g = gap_at(cp, &v);
             if !self.lin.contains(&g) {
                 ok = Verdict::Right;
@@ -1240,11 +1357,15 @@ impl<'a, const D: usize> Solver<'a, D> {
         // Left: recover inwards from the window; failed points must stay open.
         let mut next = self.q[i0];
         let mut j = i0;
-        while j > lay.first && xs[i0] - xs[j - 1] <= zone {
+        if !lay.contacts_open(i0, &next) {
+            ok = Verdict::Left;
+        }
+        // Behind the interface's first node only the contact points of the cracked faces.
+        let bottom = if lay.contacts.is_empty() { lay.first } else { 0 };
+        while j > bottom && xs[i0] - xs[j - 1] <= zone {
             j -= 1;
             let v = self.left_value(j, &next);
-            let g = self.gap(j, &v);
-            if g[0] < 0.0 {
+            if j >= lay.first && self.gap(j, &v)[0] < 0.0 || !lay.contacts_open(j, &v) {
                 ok = Verdict::Left;
             }
             next = v;
@@ -1274,7 +1395,9 @@ impl<'a, const D: usize> Solver<'a, D> {
         let lay = &self.lay;
         let (i0, i1) = (self.i0, self.i1);
         let mut e = 0.0;
-        // Left: ½ (P c + f·q_{i0}) with f the force of element (i0 − 1, i0) on node i0.
+        // Left: ½ (P_L c + f·q_{i0}) with f the force of element (i0 − 1, i0) on node i0 and P_L
+        // the control's force from the left region (the whole reaction unless the control couples
+        // to a node of the interface).
         {
             let qp = self.left_value(i0 - 1, &self.q[i0]);
             let mut f = blk_vec(&lay.kl[i0 - 1], &qp);
@@ -1283,7 +1406,18 @@ impl<'a, const D: usize> Solver<'a, D> {
             for a in 0..D {
                 f[a] += kc[a] * self.c;
             }
-            e += 0.5 * (self.reaction * self.c + dot(&f, &self.q[i0]));
+            let mut p_left = self.sigma * self.c;
+            for a in 0..D {
+                p_left += self.rho[a] * self.q[i0][a];
+            }
+            e += 0.5 * (p_left * self.c + dot(&f, &self.q[i0]));
+        }
+        if let Some((a, b)) = lay.control_nodes {
+            // The control's coupling to nodes of the window, and the right region's share.
+            for j in a.max(i0 + 1)..=b.min(i1) {
+                e += self.c * dot(&lay.kc[j], &self.q[j]);
+            }
+            e += 0.5 * self.right_control_force() * self.c;
         }
         // Right: ½ f·q_{i1}, f the force of element (i1, i1 + 1) and its elastic segment on node i1.
         if i1 < lay.last {
@@ -1579,13 +1713,17 @@ impl<'a, const D: usize> Solver<'a, D> {
     /// Every point of both regions, recovered from the window: elastic on the right, failed and
     /// open on the left.
     fn final_check(&self) -> bool {
-        self.walk_condensed(self.lay.first, |j, v| {
-            if j > self.i1 {
-                self.lin.contains(&self.gap(j, v))
-            } else {
-                self.gap(j, v)[0] >= 0.0 && self.pts[self.lay.cp(j).point].state.damage >= 1.0
-            }
-        })
+        let lay = &self.lay;
+        let left_to = if lay.contacts.is_empty() { lay.first } else { 0 };
+        lay.contacts_open(self.i0, &self.q[self.i0])
+            && self.walk_condensed(left_to, |j, v| {
+                if j > self.i1 {
+                    self.lin.contains(&self.gap(j, v))
+                } else {
+                    lay.contacts_open(j, v)
+                        && (j < lay.first || self.gap(j, v)[0] >= 0.0 && self.pts[lay.cp(j).point].state.damage >= 1.0)
+                }
+            })
     }
 
     fn run(&mut self) -> Result<(Vec<StepRow>, RunStats), Unfit> {
