@@ -42,3 +42,22 @@ pub fn hartlen_laws(n: usize, seed: u64) -> Vec<Box<dyn CohesiveLaw>> {
     }
     laws
 }
+
+/// `n` bilinear (B-K) laws in the parameter ranges of `examples/mixed-mode-synthetic/problem.toml`
+/// (σ_n 5–80 and σ_t 5–120 MPa log-uniform, G_Ic 0.2–2 and G_IIc 0.3–8 N/mm, η 1–4; penalty
+/// 10⁵ MPa/mm), the first one the MMB bench's law (`Mmb::hartlen_half_mode_two`).
+#[allow(dead_code)] // `examples/mmb_population.rs` uses it, the other includers do not
+pub fn mixed_mode_laws(n: usize, seed: u64) -> Vec<Bilinear> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut laws = vec![Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).expect("the bench's law is valid")];
+    while laws.len() < n {
+        let lin = |rng: &mut ChaCha8Rng, lo: f64, hi: f64| lo + (hi - lo) * rng.random::<f64>();
+        let log = |rng: &mut ChaCha8Rng, lo: f64, hi: f64| lo * (hi / lo).powf(rng.random::<f64>());
+        let (sn, gi, st) = (log(&mut rng, 5.0, 80.0), lin(&mut rng, 0.2, 2.0), log(&mut rng, 5.0, 120.0));
+        let (gii, eta) = (lin(&mut rng, 0.3, 8.0), lin(&mut rng, 1.0, 4.0));
+        if let Ok(law) = Bilinear::bk(1e5, sn, st, gi, gii, eta) {
+            laws.push(law);
+        }
+    }
+    laws
+}

@@ -31,9 +31,10 @@
 //! window and their gaps checked; at the end of the run every point is checked. A step whose
 //! check fails is repeated with a wider window; a run whose final check fails (or that does not
 //! fit the assumptions) is repeated on the whole mesh by [`super::path`]. A run
-//! that gives up part way, where the path turns back (a specimen splitting) or the window reaches
-//! the far end, hands its last committed state to the whole mesh, which goes on from there
-//! (`Resume`) instead of starting again from rest.
+//! that gives up part way, where the path turns back (a specimen splitting), the window reaches
+//! the far end or it spans three quarters of the interface (a process zone as long as the
+//! specimen, where it saves little), hands its last committed state to the whole mesh, which goes
+//! on from there (`Resume`) instead of starting again from rest.
 //!
 //! **Cost.** The right region is eliminated once per run (from the far end: the elimination up to
 //! any node is a prefix of the same sweep), the left one incrementally as points fail and leave the
@@ -1757,6 +1758,15 @@ impl<'a, const D: usize> Solver<'a, D> {
         while pos < target - eps {
             if self.stats.steps > max_steps {
                 return Err(Unfit::Run("too many steps"));
+            }
+            if 4 * (self.i1 + 1 - self.i0) > 3 * (self.lay.last + 1 - self.lay.first) {
+                // A process zone as long as the specimen (a weak shear branch in a mixed-mode
+                // test): the window saves little and its Newton lacks the whole mesh's safeguards,
+                // so the whole mesh goes on from here, under the same control.
+                let why = "the window spans most of the interface";
+                let at = Cursor { pos, h, k_out, external, front };
+                self.resume = self.resume_state(why, false, std::mem::take(&mut rows), at, &states);
+                return Err(Unfit::Run(why));
             }
             while k_out < s.outputs && spacing * k_out as f64 <= pos + eps {
                 k_out += 1;
