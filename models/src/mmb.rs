@@ -476,6 +476,47 @@ mod tests {
         }
     }
 
+    /// A weak shear branch (σ_t 6.4 MPa) grows a process zone over the whole ligament: the window
+    /// hands its state to the whole mesh once it spans three quarters of the interface, and the
+    /// run goes on there under the same control (on the snap-back at the peak, where the window's
+    /// Newton could not converge, the whole mesh took thirty times as long going on from the
+    /// window's state as from rest).
+    #[test]
+    fn a_window_over_most_of_the_interface_hands_the_run_to_the_whole_mesh() {
+        let (m, _) = Mmb::hartlen_half_mode_two();
+        let law = crate::laws::Bilinear::bk(1e5, 21.527, 6.3613, 0.74535, 2.7863, 1.6521).unwrap();
+        let (p, scale, cl) = m.build(&law).unwrap();
+        let path = m.path(&law, &scale, cl);
+        let run = |window: bool| fe::run_with(&p, &law, &path, &fe::RunOptions { window, ..RUN }).unwrap();
+        let ((whole, sw), (handed, sh)) = (run(false), run(true));
+        assert!(sh.resumed_from_window, "{sh:?}");
+        assert_eq!(sh.window_fallback, Some("the window spans most of the interface"), "{sh:?}");
+        // About as many steps as from rest: not the creeping continuation along the snap-back.
+        assert!(sh.steps < 2 * sw.steps, "{sh:?} against {sw:?}");
+        assert_eq!(whole.len(), handed.len());
+        let peak = whole.iter().map(|r| r.reaction.abs()).fold(0.0, f64::max);
+        let worst = whole.iter().zip(&handed).map(|(a, b)| (a.reaction - b.reaction).abs() / peak).fold(0.0, f64::max);
+        assert!(worst < 1e-7, "loads differ by {worst:.1e} of the peak");
+    }
+
+    /// At pure mode II (the lever at L/3) the window cannot take its smallest step at the peak,
+    /// and the whole mesh cannot go on from the window's state along the snap-back: it starts again
+    /// from rest, and the record is the whole mesh's own, bit for bit.
+    #[test]
+    fn a_whole_mesh_that_cannot_go_on_from_the_windows_state_starts_from_rest() {
+        let mut m = Mmb::hartlen(Mmb::lever_for_mode_ratio(50.0, 1.0));
+        m.control.output_points = 100;
+        let law = crate::laws::Bilinear::bk(1e6, 30.0, 30.0, 1.0, 1.0, 2.0).unwrap();
+        let (p, scale, cl) = m.build(&law).unwrap();
+        let path = m.path(&law, &scale, cl);
+        let run = |window: bool| fe::run_with(&p, &law, &path, &fe::RunOptions { window, ..RUN }).unwrap();
+        let ((whole, sw), (again, sa)) = (run(false), run(true));
+        assert_eq!(sa.window_fallback, Some("no convergence even with the smallest step"), "{sa:?}");
+        assert!(!sa.resumed_from_window, "{sa:?}");
+        assert_eq!((sa.steps, sa.assemblies), (sw.steps, sw.assemblies));
+        assert_eq!(whole, again);
+    }
+
     /// An ENF's cracked faces press on each other: the window, which holds them open, sees them
     /// close and leaves the run to the whole mesh, whose record it then is.
     #[test]
