@@ -1,7 +1,7 @@
 //! Laws a run is benchmarked with: a population drawn as an identification draws it (uniform in
 //! each parameter's range, log-uniform where the problem file says `scale = "log"`), so a
 //! benchmark cycles through many laws instead of repeating one whose runs a cache could serve.
-//! Shared by `benches/forward.rs` and `examples/dcb_population.rs`.
+//! Shared by `benches/forward.rs`, `examples/dcb_population.rs` and `examples/mmb_population.rs`.
 
 use czid_core::CohesiveLaw;
 use czid_models::laws::{Bilinear, StCzm};
@@ -46,7 +46,7 @@ pub fn hartlen_laws(n: usize, seed: u64) -> Vec<Box<dyn CohesiveLaw>> {
 /// `n` bilinear (B-K) laws in the parameter ranges of `examples/mixed-mode-synthetic/problem.toml`
 /// (σ_n 5–80 and σ_t 5–120 MPa log-uniform, G_Ic 0.2–2 and G_IIc 0.3–8 N/mm, η 1–4; penalty
 /// 10⁵ MPa/mm), the first one the MMB bench's law (`Mmb::hartlen_half_mode_two`).
-#[allow(dead_code)] // `examples/mmb_population.rs` uses it, the other includers do not
+#[allow(dead_code)] // `benches/forward.rs` and `examples/mmb_population.rs` use it, `examples/dcb_population.rs` does not
 pub fn mixed_mode_laws(n: usize, seed: u64) -> Vec<Bilinear> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut laws = vec![Bilinear::bk(1e5, 25.0, 35.0, 0.8, 3.0, 2.2).expect("the bench's law is valid")];
