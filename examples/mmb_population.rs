@@ -16,7 +16,16 @@ use czid_models::mmb::Mmb;
 use std::time::Instant;
 
 fn main() {
-    let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(40);
+    let n: usize = match std::env::args().nth(1) {
+        None => 40,
+        Some(arg) => match arg.parse() {
+            Ok(n) if n > 0 => n,
+            _ => {
+                eprintln!("mmb_population: the number of laws must be a positive integer, not `{arg}`");
+                std::process::exit(2);
+            }
+        },
+    };
     let (mmb, _) = Mmb::hartlen_half_mode_two();
     let (mut worst, mut ratios, mut windowed) = (Vec::new(), Vec::new(), 0);
     for (i, law) in population::mixed_mode_laws(n, 7).iter().enumerate() {

@@ -420,6 +420,22 @@ impl ForwardModel for Mmb {
 mod tests {
     use super::*;
 
+    /// `m` at `law` on the whole mesh and with the window asked for: rows and statistics of each.
+    fn both_runs(m: &Mmb, law: &dyn CohesiveLaw) -> (EngineOk, EngineOk) {
+        let (p, scale, cl) = m.build(law).unwrap();
+        let path = m.path(law, &scale, cl);
+        let run = |window: bool| fe::run_with(&p, law, &path, &fe::RunOptions { window, ..RUN }).unwrap();
+        (run(false), run(true))
+    }
+
+    type EngineOk = (Vec<StepRow>, fe::RunStats);
+
+    /// The largest load difference between two records of the same outputs, of the first's peak.
+    fn load_difference(a: &[StepRow], b: &[StepRow]) -> f64 {
+        let peak = a.iter().map(|r| r.reaction.abs()).fold(0.0, f64::max);
+        a.iter().zip(b).map(|(x, y)| (x.reaction - y.reaction).abs() / peak).fold(0.0, f64::max)
+    }
+
     /// The window around the crack front against the whole mesh on the same problem and path:
     /// the condensed regions are exact, so the two differ by the Newton tolerance only. Three
     /// mode ratios (G_II/G = 0.2, 0.5 and 0.8 by beam theory), the saddle ahead of the front.
@@ -429,10 +445,7 @@ mod tests {
             let (mut m, law) = Mmb::hartlen_half_mode_two();
             m.lever = Mmb::lever_for_mode_ratio(m.half_span, psi);
             m.control.max_displacement = None;
-            let (p, scale, cl) = m.build(&law).unwrap();
-            let path = m.path(&law, &scale, cl);
-            let run = |window: bool| fe::run_with(&p, &law, &path, &fe::RunOptions { window, ..RUN }).unwrap();
-            let ((whole, sw), (win, sv)) = (run(false), run(true));
+            let ((whole, sw), (win, sv)) = both_runs(&m, &law);
             println!("G_II/G {psi}: whole mesh {sw:?}\n           window     {sv:?}");
             assert!(sv.windowed && !sw.windowed, "{sv:?}");
             assert_eq!(whole.len(), win.len());
@@ -485,17 +498,13 @@ mod tests {
     fn a_window_over_most_of_the_interface_hands_the_run_to_the_whole_mesh() {
         let (m, _) = Mmb::hartlen_half_mode_two();
         let law = crate::laws::Bilinear::bk(1e5, 21.527, 6.3613, 0.74535, 2.7863, 1.6521).unwrap();
-        let (p, scale, cl) = m.build(&law).unwrap();
-        let path = m.path(&law, &scale, cl);
-        let run = |window: bool| fe::run_with(&p, &law, &path, &fe::RunOptions { window, ..RUN }).unwrap();
-        let ((whole, sw), (handed, sh)) = (run(false), run(true));
+        let ((whole, sw), (handed, sh)) = both_runs(&m, &law);
         assert!(sh.resumed_from_window, "{sh:?}");
         assert_eq!(sh.window_fallback, Some("the window spans most of the interface"), "{sh:?}");
         // About as many steps as from rest: not the creeping continuation along the snap-back.
         assert!(sh.steps < 2 * sw.steps, "{sh:?} against {sw:?}");
         assert_eq!(whole.len(), handed.len());
-        let peak = whole.iter().map(|r| r.reaction.abs()).fold(0.0, f64::max);
-        let worst = whole.iter().zip(&handed).map(|(a, b)| (a.reaction - b.reaction).abs() / peak).fold(0.0, f64::max);
+        let worst = load_difference(&whole, &handed);
         assert!(worst < 1e-7, "loads differ by {worst:.1e} of the peak");
     }
 
@@ -507,10 +516,7 @@ mod tests {
         let mut m = Mmb::hartlen(Mmb::lever_for_mode_ratio(50.0, 1.0));
         m.control.output_points = 100;
         let law = crate::laws::Bilinear::bk(1e6, 30.0, 30.0, 1.0, 1.0, 2.0).unwrap();
-        let (p, scale, cl) = m.build(&law).unwrap();
-        let path = m.path(&law, &scale, cl);
-        let run = |window: bool| fe::run_with(&p, &law, &path, &fe::RunOptions { window, ..RUN }).unwrap();
-        let ((whole, sw), (again, sa)) = (run(false), run(true));
+        let ((whole, sw), (again, sa)) = both_runs(&m, &law);
         assert_eq!(sa.window_fallback, Some("no convergence even with the smallest step"), "{sa:?}");
         assert!(!sa.resumed_from_window, "{sa:?}");
         assert_eq!((sa.steps, sa.assemblies), (sw.steps, sw.assemblies));

@@ -1014,20 +1014,41 @@ impl<'a, const D: usize> Solver<'a, D> {
     /// Unknowns of the right region's node `j` (`j > i1`) from those of node `j − 1`.
     fn right_value(&self, j: usize, prev: &Vct<D>) -> Vct<D> {
         let mut v = blk_vec(&self.tr[j], prev);
+        self.add_control_column(j, &mut v);
+        v
+    }
+
+    /// Adds the control's part `trc[j] c` to the right region's node `j` recovered from its
+    /// neighbour (nothing where the control couples to no node of the interface).
+    #[inline(always)]
+    fn add_control_column(&self, j: usize, v: &mut Vct<D>) {
         if let Some(tc) = self.trc.get(j) {
             for a in 0..D {
                 v[a] += tc[a] * self.c;
             }
         }
-        v
     }
 
-    /// The control's force from the right region (nodes after `i1`), `ra·q_{i1} + rs c`.
-    fn right_control_force(&self) -> f64 {
-        match (self.ra.get(self.i1 + 1), self.rs.get(self.i1 + 1)) {
-            (Some(ra), Some(rs)) => dot(ra, &self.q[self.i1]) + rs * self.c,
-            _ => 0.0,
+    /// The control's force from each region at the current unknowns: the left region's
+    /// `σ c + ρ·q_{i0}` (with the control's own stiffness and its coupling to node `i0`), the
+    /// window's nodes after `i0`, and the right region's `ra·q_{i1} + rs c`. Their sum is the
+    /// reaction; the energies take each region's share.
+    fn control_forces(&self) -> [f64; 3] {
+        let (i0, i1) = (self.i0, self.i1);
+        let mut left = self.sigma * self.c;
+        for a in 0..D {
+            left += self.rho[a] * self.q[i0][a];
         }
+        let (mut window, mut right) = (0.0, 0.0);
+        if let Some((a, b)) = self.lay.control_nodes {
+            for j in a.max(i0 + 1)..=b.min(i1) {
+                window += dot(&self.lay.kc[j], &self.q[j]);
+            }
+            if let (Some(ra), Some(rs)) = (self.ra.get(i1 + 1), self.rs.get(i1 + 1)) {
+                right = dot(ra, &self.q[i1]) + rs * self.c;
+            }
+        }
+        [left, window, right]
     }
 
     fn gap(&self, node: usize, q: &Vct<D>) -> Gap {
@@ -1159,16 +1180,9 @@ impl<'a, const D: usize> Solver<'a, D> {
             }
         }
         // Reaction at the control unknown.
-        let mut react = self.sigma * self.c;
-        for a in 0..D {
-            react += self.rho[a] * self.q[i0][a];
-        }
-        if let Some((a, b)) = lay.control_nodes {
-            for j in a.max(i0 + 1)..=b.min(i1) {
-                react += dot(&lay.kc[j], &self.q[j]);
-            }
-            react += self.right_control_force();
-        }
+        let [left, window, right] = self.control_forces();
+        // Only the left region's where the control couples to no node of the interface (a DCB).
+        let react = if lay.control_nodes.is_some() { left + window + right } else { left };
         self.reaction = react;
         let mut rmax = 0.0f64;
         let mut fmax = react.abs();
@@ -1341,11 +1355,7 @@ impl<'a, const D: usize> Solver<'a, D> {
         let (tr, chain) = (&self.tr[i1 + 1..end], &lay.chain[i1 + 1 - lay.first..end - lay.first]);
         for (j, (t, cp)) in (i1 + 1..end).zip(tr.iter().zip(chain)) {
             let mut v = blk_vec(t, &prev);
-            if let Some(tc) = self.trc.get(j) {
-                for a in 0..D {
-                    v[a] += tc[a] * self.c;
-                }
-            }
+            self.add_control_column(j, &mut v);
             let g = gap_at(cp, &v);
             if !self.lin.contains(&g) {
                 ok = Verdict::Right;
@@ -1396,6 +1406,7 @@ impl<'a, const D: usize> Solver<'a, D> {
         let lay = &self.lay;
         let (i0, i1) = (self.i0, self.i1);
         let mut e = 0.0;
+        let control = self.control_forces();
         // Left: ½ (P_L c + f·q_{i0}) with f the force of element (i0 − 1, i0) on node i0 and P_L
         // the control's force from the left region (the whole reaction unless the control couples
         // to a node of the interface).
@@ -1407,18 +1418,11 @@ impl<'a, const D: usize> Solver<'a, D> {
             for a in 0..D {
                 f[a] += kc[a] * self.c;
             }
-            let mut p_left = self.sigma * self.c;
-            for a in 0..D {
-                p_left += self.rho[a] * self.q[i0][a];
-            }
-            e += 0.5 * (p_left * self.c + dot(&f, &self.q[i0]));
+            e += 0.5 * (control[0] * self.c + dot(&f, &self.q[i0]));
         }
-        if let Some((a, b)) = lay.control_nodes {
+        if lay.control_nodes.is_some() {
             // The control's coupling to nodes of the window, and the right region's share.
-            for j in a.max(i0 + 1)..=b.min(i1) {
-                e += self.c * dot(&lay.kc[j], &self.q[j]);
-            }
-            e += 0.5 * self.right_control_force() * self.c;
+            e += self.c * control[1] + 0.5 * control[2] * self.c;
         }
         // Right: ½ f·q_{i1}, f the force of element (i1, i1 + 1) and its elastic segment on node i1.
         if i1 < lay.last {
