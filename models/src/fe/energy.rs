@@ -223,20 +223,7 @@ fn split(pure: bool, (a, b): (f64, f64), level: Option<f64>, beyond: &dyn Fn(f64
     if beyond(0.0) || !beyond(1.0) {
         return None;
     }
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        // Once `lo` and `hi` are neighbours, further halvings evaluate the law and change nothing.
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if beyond(mid) {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    Some(lo)
+    Some(super::segment::bisect_halvings(0.0, 1.0, 60, beyond))
 }
 
 /// Adds to the breakpoints `bp[..n]` of [`path_work_split`] the law's first `count` inner kinks

@@ -203,8 +203,14 @@ fn bracket_and_bisect(lo: f64, mut hi: f64, beyond: impl Fn(f64) -> bool) -> Opt
 
 /// The point of `[lo, hi]` where `beyond` switches from false (at `lo`) to true (at `hi`), to
 /// round-off: the last value for which it is false.
-fn bisect(mut lo: f64, mut hi: f64, beyond: impl Fn(f64) -> bool) -> f64 {
-    for _ in 0..200 {
+fn bisect(lo: f64, hi: f64, beyond: impl Fn(f64) -> bool) -> f64 {
+    bisect_halvings(lo, hi, 200, beyond)
+}
+
+/// [`bisect`] with at most `halvings` halvings (it stops earlier once `lo` and `hi` are
+/// neighbouring numbers, where a further halving would evaluate `beyond` and change nothing).
+pub(crate) fn bisect_halvings(mut lo: f64, mut hi: f64, halvings: usize, beyond: impl Fn(f64) -> bool) -> f64 {
+    for _ in 0..halvings {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
             break;
