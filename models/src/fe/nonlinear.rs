@@ -461,7 +461,7 @@ impl<'a> Solver<'a> {
     }
 
     /// Internal forces at `q` from the committed history `c`, with the trial history and the
-    /// stiffnesses [`Solver::tangent`] assembles; `false` if something is not finite (or a
+    /// stiffnesses [`Solver::factorize_tangent`] assembles; `false` if something is not finite (or a
     /// series-compliance solve failed).
     fn assemble(&mut self, c: &History, q: &[f64], secant: bool) -> bool {
         self.stats.assemblies += 1;

@@ -1,0 +1,160 @@
+//! Node-block algebra of the window: `D × D` blocks and `D`-vectors as arrays, and the LU
+//! factors of a block.
+
+/// Node blocks: every node carries `D` unknowns, nodes with fewer padded with unknowns of unit
+/// stiffness coupled to nothing (they stay zero).
+pub(super) type Blk<const D: usize> = [[f64; D]; D];
+/// A node's unknowns, or the forces on them.
+pub(super) type Vct<const D: usize> = [f64; D];
+
+/// The zero block.
+pub(super) fn zb<const D: usize>() -> Blk<D> {
+    [[0.0; D]; D]
+}
+
+/// `A B`.
+#[inline(always)]
+pub(super) fn blk_mul<const D: usize>(a: &Blk<D>, b: &Blk<D>) -> Blk<D> {
+    let mut o = zb::<D>();
+    for i in 0..D {
+        for l in 0..D {
+            let v = a[i][l];
+            for j in 0..D {
+                o[i][j] += v * b[l][j];
+            }
+        }
+    }
+    o
+}
+
+/// `A v`.
+#[inline(always)]
+pub(super) fn blk_vec<const D: usize>(a: &Blk<D>, v: &Vct<D>) -> Vct<D> {
+    let mut o = [0.0; D];
+    for i in 0..D {
+        let mut s = 0.0;
+        for j in 0..D {
+            s += a[i][j] * v[j];
+        }
+        o[i] = s;
+    }
+    o
+}
+
+/// LU factors of a node block with partial pivoting.
+#[derive(Clone, Copy)]
+pub(super) struct Lu<const D: usize> {
+    pub(super) m: Blk<D>,
+    pub(super) perm: [usize; D],
+}
+
+impl<const D: usize> Lu<D> {
+    pub(super) fn new(a: &Blk<D>) -> Option<Lu<D>> {
+        let mut m = *a;
+        let mut perm = [0; D];
+        for (i, p) in perm.iter_mut().enumerate() {
+            *p = i;
+        }
+        let scale = (0..D).fold(0.0f64, |s, i| s.max(m[i][i].abs())).max(1e-300);
+        for k in 0..D {
+            let mut piv = k;
+            for i in k + 1..D {
+                if m[i][k].abs() > m[piv][k].abs() {
+                    piv = i;
+                }
+            }
+            if m[piv][k].abs() <= 1e-14 * scale || !m[piv][k].is_finite() {
+                return None;
+            }
+            m.swap(k, piv);
+            perm.swap(k, piv);
+            let inv = 1.0 / m[k][k];
+            for i in k + 1..D {
+                let l = m[i][k] * inv;
+                m[i][k] = l;
+                for j in k + 1..D {
+                    m[i][j] -= l * m[k][j];
+                }
+            }
+            m[k][k] = inv;
+        }
+        Some(Lu { m, perm })
+    }
+
+    #[inline(always)]
+    pub(super) fn solve(&self, b: &Vct<D>) -> Vct<D> {
+        let mut x = [0.0; D];
+        for i in 0..D {
+            x[i] = b[self.perm[i]];
+        }
+        for i in 0..D {
+            for j in 0..i {
+                x[i] -= self.m[i][j] * x[j];
+            }
+        }
+        for i in (0..D).rev() {
+            for j in i + 1..D {
+                x[i] -= self.m[i][j] * x[j];
+            }
+            x[i] *= self.m[i][i];
+        }
+        x
+    }
+
+    /// `A⁻¹ B`.
+    pub(super) fn solve_blk(&self, b: &Blk<D>) -> Blk<D> {
+        let mut o = zb::<D>();
+        for j in 0..D {
+            let mut col = [0.0; D];
+            for i in 0..D {
+                col[i] = b[i][j];
+            }
+            let x = self.solve(&col);
+            for i in 0..D {
+                o[i][j] = x[i];
+            }
+        }
+        o
+    }
+}
+
+/// `A += B`.
+pub(super) fn add<const D: usize>(a: &mut Blk<D>, b: &Blk<D>) {
+    for i in 0..D {
+        for j in 0..D {
+            a[i][j] += b[i][j];
+        }
+    }
+}
+
+/// `A −= B`.
+pub(super) fn sub<const D: usize>(a: &mut Blk<D>, b: &Blk<D>) {
+    for i in 0..D {
+        for j in 0..D {
+            a[i][j] -= b[i][j];
+        }
+    }
+}
+
+/// `−A`.
+pub(super) fn neg<const D: usize>(a: &Blk<D>) -> Blk<D> {
+    let mut o = *a;
+    for row in o.iter_mut() {
+        for v in row.iter_mut() {
+            *v = -*v;
+        }
+    }
+    o
+}
+
+/// `a += b`.
+pub(super) fn addv<const D: usize>(a: &mut Vct<D>, b: &Vct<D>) {
+    for i in 0..D {
+        a[i] += b[i];
+    }
+}
+
+/// `a·b`.
+pub(super) fn dot<const D: usize>(a: &Vct<D>, b: &Vct<D>) -> f64 {
+    (0..D).map(|i| a[i] * b[i]).sum()
+}

@@ -1,0 +1,287 @@
+//! Newton's iterations over the window: assembly, the block tridiagonal elimination, chord
+//! corrections.
+
+use czid_core::{Gap, LawState};
+
+use super::Solver;
+use crate::fe::newton::CHORD_CONTRACTION;
+use crate::fe::segment::{self, End};
+use crate::fe::window::blocks::{add, addv, blk_mul, blk_vec, sub, Lu, Vct};
+use crate::fe::window::layout::gap_at;
+
+impl<'a, const D: usize> Solver<'a, D> {
+    pub(super) fn gap(&self, node: usize, q: &Vct<D>) -> Gap {
+        gap_at(self.lay.cp(node), q)
+    }
+
+    /// Assembles the window's residual (into `res`) and Jacobian blocks at the current `q`, `c`;
+    /// returns the residual's largest entry and the scale of the internal forces.
+    pub(super) fn assemble(&mut self, states: &[LawState], tangent: bool) -> Result<(f64, f64), ()> {
+        let (i0, i1) = (self.i0, self.i1);
+        let lay = &self.lay;
+        self.stats.assemblies += 1;
+        // Linear parts.
+        for j in i0..=i1 {
+            let mut a = lay.kd[j];
+            // The control's column at node j: its own coupling, or the right region's through it.
+            let mut ctl = None;
+            if j == i1 && j < lay.last {
+                let k = j - lay.first;
+                add(&mut a, &self.es_aa[k]);
+                let mut e_up = lay.ku[j];
+                add(&mut e_up, &self.es_ab[k]);
+                let s = blk_mul(&e_up, &self.tr[j + 1]);
+                add(&mut a, &s);
+                if let Some(tc) = self.trc.get(j + 1) {
+                    ctl = Some(blk_vec(&e_up, tc));
+                }
+            }
+            if j > i0 && lay.control_nodes.is_some_and(|(a, b)| a <= j && j <= b) {
+                let mut v = ctl.unwrap_or([0.0; D]);
+                addv(&mut v, &lay.kc[j]);
+                ctl = Some(v);
+            }
+            if j == i0 {
+                let s = blk_mul(&lay.kl[j - 1], &self.tl[j - 1]);
+                add(&mut a, &s);
+            }
+            let mut r = blk_vec(&a, &self.q[j]);
+            if tangent {
+                self.jd[j] = a;
+            }
+            if j > i0 {
+                let v = blk_vec(&lay.kl[j - 1], &self.q[j - 1]);
+                addv(&mut r, &v);
+            }
+            if j < i1 {
+                let v = blk_vec(&lay.ku[j], &self.q[j + 1]);
+                addv(&mut r, &v);
+                if tangent {
+                    self.ju[j] = lay.ku[j];
+                    self.jl[j] = lay.kl[j];
+                }
+            }
+            if j == i0 {
+                let v = blk_vec(&lay.kl[j - 1], &self.tlc[j - 1]);
+                for a in 0..D {
+                    r[a] += (v[a] + lay.kc[j][a]) * self.c;
+                }
+            }
+            if let Some(v) = ctl {
+                for a in 0..D {
+                    r[a] += v[a] * self.c;
+                }
+            }
+            self.res[j] = r;
+        }
+        // Interface: law at the window's points, segments between them.
+        let mut ok = true;
+        for j in i0..=i1 {
+            let pi = lay.cp(j).point;
+            let g = self.gap(j, &self.q[j]);
+            let ev = self.law.evaluate(&g, &states[pi]);
+            // The law's own tangent: with segments the forces are continuous at a point's elastic
+            // limit, and Newton converges there with the one-sided tangent, while the nodal rule's
+            // loading-branch bias would be an inconsistent Jacobian (linear convergence, or
+            // divergence, for a point converging just inside its limit).
+            let d = ev.tangent;
+            if !(ev.traction.iter().all(|v| v.is_finite()) && d.iter().all(|v| v.is_finite())) {
+                ok = false;
+            }
+            self.gaps[pi] = g;
+            self.ev[pi] = ev;
+            self.dt[pi] = d;
+        }
+        if !ok {
+            return Err(());
+        }
+        for j in i0..i1 {
+            let k = j - lay.first;
+            let sg = &lay.segs[k];
+            let end = |i: usize| End {
+                gap: self.gaps[i],
+                t: self.ev[i].traction,
+                d: self.dt[i],
+                trial: &self.ev[i].state,
+                state: &states[i],
+            };
+            let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), self.law, Some(&self.mode_one));
+            self.fronts[k] = sf.fronts;
+            self.seg_stored[k] = sf.stored;
+            let nodes = [j, j + 1];
+            for (x, &nx) in nodes.iter().enumerate() {
+                let gx = &lay.cp(nx).grad;
+                for a in 0..D {
+                    self.res[nx][a] += gx[0][a] * sf.f[x][0] + gx[1][a] * sf.f[x][1];
+                }
+                if !tangent {
+                    continue;
+                }
+                for (y, &ny) in nodes.iter().enumerate() {
+                    let gy = &lay.cp(ny).grad;
+                    let jac = &sf.jac[x][y];
+                    let blk = match (x, y) {
+                        (0, 0) | (1, 1) => &mut self.jd[nx],
+                        (0, 1) => &mut self.ju[j],
+                        _ => &mut self.jl[j],
+                    };
+                    for a in 0..D {
+                        let r0 = gx[0][a] * jac[(0, 0)] + gx[1][a] * jac[(1, 0)];
+                        let r1 = gx[0][a] * jac[(0, 1)] + gx[1][a] * jac[(1, 1)];
+                        if r0 == 0.0 && r1 == 0.0 {
+                            continue;
+                        }
+                        for b in 0..D {
+                            blk[a][b] += r0 * gy[0][b] + r1 * gy[1][b];
+                        }
+                    }
+                }
+            }
+        }
+        // Reaction at the control unknown.
+        let [left, window, right] = self.control_forces();
+        // Only the left region's where the control couples to no node of the interface (a DCB).
+        let react = if lay.control_nodes.is_some() { left + window + right } else { left };
+        self.reaction = react;
+        let mut rmax = 0.0f64;
+        let mut fmax = react.abs();
+        for j in i0..=i1 {
+            for a in 0..D {
+                rmax = rmax.max(self.res[j][a].abs());
+            }
+            // Interface forces give the scale of the internal forces in the window.
+            let pi = lay.cp(j).point;
+            fmax = fmax.max(self.ev[pi].traction.norm() * lay.cp(j).weight);
+        }
+        Ok((rmax, fmax))
+    }
+
+    /// Solves the block tridiagonal system `J Δq = −res` over the window and adds `Δq` to `q`;
+    /// returns the largest correction relative to the largest unknown.
+    pub(super) fn correct(&mut self) -> Result<f64, ()> {
+        self.stats.factorizations += 1;
+        let mut lus = std::mem::take(&mut self.lus);
+        let mut rhs = std::mem::take(&mut self.rhs);
+        lus.clear();
+        rhs.resize(self.i1 - self.i0 + 1, [0.0; D]);
+        let out = self.eliminate(&mut lus, &mut rhs);
+        self.lus = lus;
+        self.rhs = rhs;
+        out
+    }
+
+    /// A chord correction: [`Solver::correct`] with the block factors of its last call, for the
+    /// residual of the current unknowns.
+    pub(super) fn correct_chord(&mut self) -> f64 {
+        let lus = std::mem::take(&mut self.lus);
+        let mut rhs = std::mem::take(&mut self.rhs);
+        for j in self.i0..=self.i1 {
+            rhs[j - self.i0] = self.forward_row(&lus, &rhs, j);
+        }
+        let out = self.substitute(&lus, &rhs);
+        self.lus = lus;
+        self.rhs = rhs;
+        out
+    }
+
+    /// Block elimination of the window's tangent, `D_j = J_jj − J_{j,j−1} D_{j−1}⁻¹ J_{j−1,j}`
+    /// (the LU factors of each `D_j` into `lus`), with the residual's forward elimination in the
+    /// same pass; then [`Solver::substitute`].
+    pub(super) fn eliminate(&mut self, lus: &mut Vec<Lu<D>>, rhs: &mut [Vct<D>]) -> Result<f64, ()> {
+        let i0 = self.i0;
+        for j in i0..=self.i1 {
+            let mut dd = self.jd[j];
+            if j > i0 {
+                let x = lus[j - 1 - i0].solve_blk(&self.ju[j - 1]);
+                let s = blk_mul(&self.jl[j - 1], &x);
+                sub(&mut dd, &s);
+            }
+            rhs[j - i0] = self.forward_row(lus, rhs, j);
+            lus.push(Lu::new(&dd).ok_or(())?);
+        }
+        Ok(self.substitute(lus, rhs))
+    }
+
+    /// Node `j`'s row of the forward elimination of `−res`, from the rows before it. (Inlined:
+    /// it runs per node of every correction; as a call it cost a run 1 % more instructions.)
+    #[inline(always)]
+    pub(super) fn forward_row(&self, lus: &[Lu<D>], rhs: &[Vct<D>], j: usize) -> Vct<D> {
+        let i0 = self.i0;
+        let mut r = self.res[j];
+        for a in 0..D {
+            r[a] = -r[a];
+        }
+        if j > i0 {
+            let y = lus[j - 1 - i0].solve(&rhs[j - 1 - i0]);
+            let v = blk_vec(&self.jl[j - 1], &y);
+            for a in 0..D {
+                r[a] -= v[a];
+            }
+        }
+        r
+    }
+
+    /// Back substitution of the eliminated system: adds `Δq` to `q` and returns the largest
+    /// correction relative to the largest unknown.
+    pub(super) fn substitute(&mut self, lus: &[Lu<D>], rhs: &[Vct<D>]) -> f64 {
+        let (i0, i1) = (self.i0, self.i1);
+        let (mut dmax, mut qmax) = (0.0f64, 0.0f64);
+        let mut next = [0.0; D];
+        for j in (i0..=i1).rev() {
+            let mut r = rhs[j - i0];
+            if j < i1 {
+                let v = blk_vec(&self.ju[j], &next);
+                for a in 0..D {
+                    r[a] -= v[a];
+                }
+            }
+            let x = lus[j - i0].solve(&r);
+            for a in 0..D {
+                self.q[j][a] += x[a];
+                dmax = dmax.max(x[a].abs());
+                qmax = qmax.max(self.q[j][a].abs());
+            }
+            next = x;
+        }
+        dmax / qmax.max(1e-300)
+    }
+
+    /// Newton iterations at the control value `self.c` from the predictor in `q`.
+    pub(super) fn solve(&mut self, states: &[LawState]) -> Result<usize, ()> {
+        let max_it = self.s.newton.max_iterations;
+        let mut stalled = false;
+        // Whether the next correction reuses the last factorisation (a chord step), and the
+        // residual of the last one that did.
+        let mut chord = false;
+        let mut chord_from = f64::INFINITY;
+        for it in 0..=max_it {
+            let (rmax, fmax) = self.assemble(states, !chord)?;
+            let tol = self.s.newton.tolerance * fmax.max(1e-300);
+            if !rmax.is_finite() {
+                return Err(());
+            }
+            if rmax <= tol || (stalled && rmax <= 1e4 * tol) {
+                return Ok(it);
+            }
+            if it == max_it {
+                break;
+            }
+            let rel = rmax / fmax.max(1e-300);
+            if chord && rel > CHORD_CONTRACTION * chord_from {
+                // The chord does not contract: a full Newton step from here (the tangent was not
+                // assembled, so assemble again).
+                chord = false;
+                chord_from = f64::INFINITY;
+                self.assemble(states, true)?;
+            }
+            stalled = if chord {
+                chord_from = rel;
+                self.correct_chord()
+            } else {
+                self.correct()?
+            } <= 1e-12;
+            chord = rel <= self.chord_below;
+        }
+        Err(())
+    }
+}
