@@ -49,9 +49,17 @@ pub(super) struct Lu<const D: usize> {
 }
 
 impl<const D: usize> Lu<D> {
+    /// The factors of `a`, or `None` where it is singular.
     pub(super) fn new(a: &Blk<D>) -> Option<Lu<D>> {
-        let mut m = *a;
-        let mut perm = [0; D];
+        let mut lu = Lu { m: *a, perm: [0; D] };
+        lu.factorize().then_some(lu)
+    }
+
+    /// Factorises the block held in `m` in place; `false` (and `m` partly eliminated) where it is
+    /// singular. In place, because a block of the MMB's seven unknowns per node is 392 bytes: built
+    /// in a local and moved into its slot, every factorisation cost two more copies.
+    pub(super) fn factorize(&mut self) -> bool {
+        let (m, perm) = (&mut self.m, &mut self.perm);
         for (i, p) in perm.iter_mut().enumerate() {
             *p = i;
         }
@@ -64,7 +72,7 @@ impl<const D: usize> Lu<D> {
                 }
             }
             if m[piv][k].abs() <= 1e-14 * scale || !m[piv][k].is_finite() {
-                return None;
+                return false;
             }
             m.swap(k, piv);
             perm.swap(k, piv);
@@ -78,7 +86,7 @@ impl<const D: usize> Lu<D> {
             }
             m[k][k] = inv;
         }
-        Some(Lu { m, perm })
+        true
     }
 
     #[inline(always)]

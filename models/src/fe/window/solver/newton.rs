@@ -6,7 +6,7 @@ use czid_core::{Gap, LawState};
 use super::Solver;
 use crate::fe::newton::CHORD_CONTRACTION;
 use crate::fe::segment::{self, End};
-use crate::fe::window::blocks::{add, addv, blk_mul, blk_vec, sub, Lu, Vct};
+use crate::fe::window::blocks::{add, addv, blk_mul, blk_vec, sub, zb, Blk, Lu, Vct};
 use crate::fe::window::layout::gap_at;
 
 impl<'a, const D: usize> Solver<'a, D> {
@@ -22,32 +22,45 @@ impl<'a, const D: usize> Solver<'a, D> {
         self.stats.assemblies += 1;
         // Linear parts.
         for j in i0..=i1 {
-            let mut a = lay.kd[j];
             // The control's column at node j: its own coupling, or the right region's through it.
             let mut ctl = None;
-            if j == i1 && j < lay.last {
-                let k = j - lay.first;
-                add(&mut a, &self.es_aa[k]);
-                let mut e_up = lay.ku[j];
-                add(&mut e_up, &self.es_ab[k]);
-                let s = blk_mul(&e_up, &self.tr[j + 1]);
-                add(&mut a, &s);
-                if let Some(tc) = self.trc.get(j + 1) {
-                    ctl = Some(blk_vec(&e_up, tc));
+            // The node's diagonal block: the linear one, with the condensed regions' stiffness at
+            // the window's ends. It is built in the tangent's slot, and read in place where nothing
+            // is added to it: a block of seven unknowns is 392 bytes, and building it in a local
+            // to copy it into the slot cost the MMB a copy per node of every assembly.
+            let ends = j == i0 || (j == i1 && j < lay.last);
+            let mut r = if tangent || ends {
+                let mut own;
+                let a: &mut Blk<D> = if tangent {
+                    self.jd[j] = lay.kd[j];
+                    &mut self.jd[j]
+                } else {
+                    own = lay.kd[j];
+                    &mut own
+                };
+                if j == i1 && j < lay.last {
+                    let k = j - lay.first;
+                    add(a, &self.es_aa[k]);
+                    let mut e_up = lay.ku[j];
+                    add(&mut e_up, &self.es_ab[k]);
+                    let s = blk_mul(&e_up, &self.tr[j + 1]);
+                    add(a, &s);
+                    if let Some(tc) = self.trc.get(j + 1) {
+                        ctl = Some(blk_vec(&e_up, tc));
+                    }
                 }
-            }
+                if j == i0 {
+                    let s = blk_mul(&lay.kl[j - 1], &self.tl[j - 1]);
+                    add(a, &s);
+                }
+                blk_vec(a, &self.q[j])
+            } else {
+                blk_vec(&lay.kd[j], &self.q[j])
+            };
             if j > i0 && lay.control_nodes.is_some_and(|(a, b)| a <= j && j <= b) {
                 let mut v = ctl.unwrap_or([0.0; D]);
                 addv(&mut v, &lay.kc[j]);
                 ctl = Some(v);
-            }
-            if j == i0 {
-                let s = blk_mul(&lay.kl[j - 1], &self.tl[j - 1]);
-                add(&mut a, &s);
-            }
-            let mut r = blk_vec(&a, &self.q[j]);
-            if tangent {
-                self.jd[j] = a;
             }
             if j > i0 {
                 let v = blk_vec(&lay.kl[j - 1], &self.q[j - 1]);
@@ -162,7 +175,6 @@ impl<'a, const D: usize> Solver<'a, D> {
         self.stats.factorizations += 1;
         let mut lus = std::mem::take(&mut self.lus);
         let mut rhs = std::mem::take(&mut self.rhs);
-        lus.clear();
         rhs.resize(self.i1 - self.i0 + 1, [0.0; D]);
         let out = self.eliminate(&mut lus, &mut rhs);
         self.lus = lus;
@@ -189,15 +201,25 @@ impl<'a, const D: usize> Solver<'a, D> {
     /// same pass; then [`Solver::substitute`].
     pub(super) fn eliminate(&mut self, lus: &mut Vec<Lu<D>>, rhs: &mut [Vct<D>]) -> Result<f64, ()> {
         let i0 = self.i0;
+        let n = self.i1 + 1 - i0;
+        lus.resize(n, Lu { m: zb::<D>(), perm: [0; D] });
         for j in i0..=self.i1 {
-            let mut dd = self.jd[j];
+            // `D_j` is built and factorised in its own slot (see `Lu::factorize`).
+            let k = j - i0;
+            let (done, rest) = lus.split_at_mut(k);
+            let lu = &mut rest[0];
+            lu.m = self.jd[j];
             if j > i0 {
-                let x = lus[j - 1 - i0].solve_blk(&self.ju[j - 1]);
+                let x = done[k - 1].solve_blk(&self.ju[j - 1]);
                 let s = blk_mul(&self.jl[j - 1], &x);
-                sub(&mut dd, &s);
+                sub(&mut lu.m, &s);
             }
-            rhs[j - i0] = self.forward_row(lus, rhs, j);
-            lus.push(Lu::new(&dd).ok_or(())?);
+            rhs[k] = self.forward_row(done, rhs, j);
+            if !lu.factorize() {
+                // Only the blocks factorised so far are factors.
+                lus.truncate(k);
+                return Err(());
+            }
         }
         Ok(self.substitute(lus, rhs))
     }
