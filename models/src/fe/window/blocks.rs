@@ -109,20 +109,39 @@ impl<const D: usize> Lu<D> {
         x
     }
 
-    /// `A⁻¹ B`.
+    /// `A⁻¹ B`: [`Lu::solve`] on all of `B`'s columns at once. Every column sees the operations
+    /// of `solve` in its order (the result is the same to the bit); a row operation spans a row of
+    /// `B`, of fixed length, where the column-by-column loops gathered each column first.
     pub(super) fn solve_blk(&self, b: &Blk<D>) -> Blk<D> {
-        let mut o = zb::<D>();
-        for j in 0..D {
-            let mut col = [0.0; D];
-            for i in 0..D {
-                col[i] = b[i][j];
-            }
-            let x = self.solve(&col);
-            for i in 0..D {
-                o[i][j] = x[i];
-            }
+        let mut x = zb::<D>();
+        for i in 0..D {
+            x[i] = b[self.perm[i]];
         }
-        o
+        for i in 0..D {
+            let mut xi = x[i];
+            for (j, xj) in x.iter().enumerate().take(i) {
+                let l = self.m[i][j];
+                for c in 0..D {
+                    xi[c] -= l * xj[c];
+                }
+            }
+            x[i] = xi;
+        }
+        for i in (0..D).rev() {
+            let mut xi = x[i];
+            for (j, xj) in x.iter().enumerate().skip(i + 1) {
+                let u = self.m[i][j];
+                for c in 0..D {
+                    xi[c] -= u * xj[c];
+                }
+            }
+            let p = self.m[i][i];
+            for v in xi.iter_mut() {
+                *v *= p;
+            }
+            x[i] = xi;
+        }
+        x
     }
 }
 
