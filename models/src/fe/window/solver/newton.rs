@@ -87,11 +87,14 @@ impl<'a, const D: usize> Solver<'a, D> {
             }
             self.res[j] = r;
         }
-        // Interface: law at the window's points, segments between them.
+        // Interface: law at the window's points, segments between them. Both loops run over the
+        // window's slices of the node-indexed arrays (no index checks but the point-indexed ones).
+        let (k0, k1) = (i0 - lay.first, i1 - lay.first);
+        let chain = &lay.chain[k0..=k1];
         let mut ok = true;
-        for j in i0..=i1 {
-            let pi = lay.cp(j).point;
-            let g = self.gap(j, &self.q[j]);
+        for (cp, q) in chain.iter().zip(&self.q[i0..=i1]) {
+            let pi = cp.point;
+            let g = gap_at(cp, q);
             let ev = self.law.evaluate(&g, &states[pi]);
             // The law's own tangent: with segments the forces are continuous at a point's elastic
             // limit, and Newton converges there with the one-sided tangent, while the nodal rule's
@@ -108,35 +111,36 @@ impl<'a, const D: usize> Solver<'a, D> {
         if !ok {
             return Err(());
         }
-        for j in i0..i1 {
-            let k = j - lay.first;
-            let sg = &lay.segs[k];
-            let end = |i: usize| End {
-                gap: self.gaps[i],
-                t: self.ev[i].traction,
-                d: self.dt[i],
-                trial: &self.ev[i].state,
-                state: &states[i],
-            };
+        let (gaps, evs, dts) = (&self.gaps, &self.ev, &self.dt);
+        let res = &mut self.res[i0..=i1];
+        let jd = &mut self.jd[i0..=i1];
+        let (ju, jl) = (&mut self.ju[i0..i1], &mut self.jl[i0..i1]);
+        let segs = lay.segs[k0..k1].iter().zip(chain.windows(2));
+        let out = self.fronts[k0..k1].iter_mut().zip(&mut self.seg_stored[k0..k1]);
+        for (k, ((sg, cps), (fronts, stored))) in segs.zip(out).enumerate() {
+            let end =
+                |i: usize| End { gap: gaps[i], t: evs[i].traction, d: dts[i], trial: &evs[i].state, state: &states[i] };
             let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), self.law, Some(&self.mode_one));
-            self.fronts[k] = sf.fronts;
-            self.seg_stored[k] = sf.stored;
-            let nodes = [j, j + 1];
-            for (x, &nx) in nodes.iter().enumerate() {
-                let gx = &lay.cp(nx).grad;
+            *fronts = sf.fronts;
+            *stored = sf.stored;
+            let (res_a, res_b) = res.split_at_mut(k + 1);
+            let (jd_a, jd_b) = jd.split_at_mut(k + 1);
+            let ends = [(&cps[0].grad, &mut res_a[k]), (&cps[1].grad, &mut res_b[0])];
+            for (x, (gx, r)) in ends.into_iter().enumerate() {
                 for a in 0..D {
-                    self.res[nx][a] += gx[0][a] * sf.f[x][0] + gx[1][a] * sf.f[x][1];
+                    r[a] += gx[0][a] * sf.f[x][0] + gx[1][a] * sf.f[x][1];
                 }
                 if !tangent {
                     continue;
                 }
-                for (y, &ny) in nodes.iter().enumerate() {
-                    let gy = &lay.cp(ny).grad;
+                for (y, cy) in cps.iter().enumerate() {
+                    let gy = &cy.grad;
                     let jac = &sf.jac[x][y];
                     let blk = match (x, y) {
-                        (0, 0) | (1, 1) => &mut self.jd[nx],
-                        (0, 1) => &mut self.ju[j],
-                        _ => &mut self.jl[j],
+                        (0, 0) => &mut jd_a[k],
+                        (1, 1) => &mut jd_b[0],
+                        (0, 1) => &mut ju[k],
+                        _ => &mut jl[k],
                     };
                     for a in 0..D {
                         let r0 = gx[0][a] * jac[(0, 0)] + gx[1][a] * jac[(1, 0)];
