@@ -30,13 +30,14 @@ pub(super) fn blk_mul<const D: usize>(a: &Blk<D>, b: &Blk<D>) -> Blk<D> {
 /// `A v`.
 #[inline(always)]
 pub(super) fn blk_vec<const D: usize>(a: &Blk<D>, v: &Vct<D>) -> Vct<D> {
+    // Column by column: every row's sum is taken in the same order as row by row (the result is
+    // the same to the bit), and the rows' sums advance together instead of one after another.
     let mut o = [0.0; D];
-    for i in 0..D {
-        let mut s = 0.0;
-        for j in 0..D {
-            s += a[i][j] * v[j];
+    for j in 0..D {
+        let vj = v[j];
+        for i in 0..D {
+            o[i] += a[i][j] * vj;
         }
-        o[i] = s;
     }
     o
 }
@@ -74,14 +75,20 @@ impl<const D: usize> Lu<D> {
             if m[piv][k].abs() <= 1e-14 * scale || !m[piv][k].is_finite() {
                 return false;
             }
-            m.swap(k, piv);
-            perm.swap(k, piv);
+            if piv != k {
+                m.swap(k, piv);
+                perm.swap(k, piv);
+            }
             let inv = 1.0 / m[k][k];
-            for i in k + 1..D {
-                let l = m[i][k] * inv;
-                m[i][k] = l;
-                for j in k + 1..D {
-                    m[i][j] -= l * m[k][j];
+            // The rows below the pivot's, each against the pivot row's part right of the
+            // diagonal (slices: no index checks in the inner loop).
+            let (top, below) = m.split_at_mut(k + 1);
+            let pivot_row = &top[k][k + 1..];
+            for row in below {
+                let l = row[k] * inv;
+                row[k] = l;
+                for (x, p) in row[k + 1..].iter_mut().zip(pivot_row) {
+                    *x -= l * p;
                 }
             }
             m[k][k] = inv;
