@@ -717,7 +717,7 @@ impl<'a> Solver<'a> {
 
     /// With extrapolated damage, after convergence: the states the law reaches at the trial law
     /// gaps from the committed states `c` (within the iterations the law is not needed, the
-    /// damage being held, and evaluating it there cost the FRP beam 7 % of its time).
+    /// damage being held, so it is evaluated once per step instead of at every assembly).
     fn update_extrapolated_states(&mut self, c: &History) {
         for ((st, g), old) in self.trial.points.iter_mut().zip(&self.trial.law_gaps).zip(&c.points) {
             *st = self.law.evaluate(g, old).state;
