@@ -15,6 +15,7 @@ use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent};
 
 use super::banded::{BandMatrix, RowSparse};
 use super::beam;
+use super::changed_rows::ChangedRows;
 use super::corotational;
 use super::interface::{self, GapKinematics, InterfacePoint, PointKind, POINT_DOFS, SIDE};
 use super::mesh::{Mesh, NONE};
@@ -145,6 +146,9 @@ pub struct Assembler {
     /// [`super::newton::Newton::active`]): only the elements, points and segments of the nodes
     /// before it are assembled, the structure cut there. `usize::MAX`: none.
     pub frozen_from_node: usize,
+    /// What the interface scattered into the tangent, for the rows that can have changed since
+    /// the last factorisation (small rotations only).
+    pub(crate) changed: ChangedRows,
 }
 
 /// Relative margin within which a cohesive point iterates with its loading-branch tangent.
@@ -202,6 +206,25 @@ impl Assembler {
         };
         let mode_one = if segments.is_empty() { None } else { ModeOne::of(law) };
         let large = p.large_rotation && !segments.is_empty();
+        let at_rest: Vec<GapKinematics> = if p.large_rotation {
+            Vec::new()
+        } else {
+            let (zero, mut hess) = (vec![0.0; n], [[[0.0; POINT_DOFS]; POINT_DOFS]; 2]);
+            p.points.iter().map(|pt| interface::kinematics(mesh, pt, &zero, false, &mut hess)).collect()
+        };
+        // The rows each interface item writes: its points' unknowns.
+        let rows_of = |ips: &[usize]| {
+            let dofs = ips.iter().flat_map(|&ip| at_rest[ip].dofs).filter(|&d| d != NONE);
+            dofs.fold(None, |r: Option<(usize, usize)>, d| Some(r.map_or((d, d), |(lo, hi)| (lo.min(d), hi.max(d)))))
+        };
+        let changed = if p.large_rotation {
+            ChangedRows::default()
+        } else {
+            ChangedRows::new(
+                (0..np).map(|ip| if covered[ip] { None } else { rows_of(&[ip]) }).collect(),
+                segments.iter().map(|sg| rows_of(&[sg.a, sg.b])).collect(),
+            )
+        };
         Assembler {
             elements,
             // (Under large rotations the band is empty: the springs are added directly.)
@@ -216,16 +239,12 @@ impl Assembler {
             mode_one,
             data: vec![PointData::default(); np],
             hessians: if large { vec![[[[0.0; POINT_DOFS]; POINT_DOFS]; 2]; np] } else { Vec::new() },
-            at_rest: if p.large_rotation {
-                Vec::new()
-            } else {
-                let (zero, mut hess) = (vec![0.0; n], [[[0.0; POINT_DOFS]; POINT_DOFS]; 2]);
-                p.points.iter().map(|pt| interface::kinematics(mesh, pt, &zero, false, &mut hess)).collect()
-            },
+            at_rest,
             n,
             strength,
             hess: Box::new([[[0.0; POINT_DOFS]; POINT_DOFS]; 2]),
             frozen_from_node: usize::MAX,
+            changed,
         }
     }
 
@@ -263,6 +282,7 @@ impl Assembler {
         } else {
             if let Some(k) = k.as_deref_mut() {
                 k.copy_from(&self.linear);
+                self.changed.start(self.frozen_from_node);
             }
             self.linear_entries.mul_vec(q, f);
         }
@@ -333,6 +353,9 @@ impl Assembler {
                 self.data[ip] = PointData::new(kin, d);
                 continue;
             }
+            if k.is_some() && !p.large_rotation {
+                self.changed.point(ip, &d);
+            }
             let w = pt.area * pt.factor;
             // f += w Gᵀ T ; K += w (Gᵀ D G + T_n H_n + T_t H_t)
             let g = &kin.grad;
@@ -377,6 +400,9 @@ impl Assembler {
             let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), law, self.mode_one.as_ref());
             self.fronts[is] = sf.fronts;
             self.segment_stored[is] = sf.stored;
+            if k.is_some() && !p.large_rotation {
+                self.changed.segment(is, &sf.jac);
+            }
             let pts = [&self.data[sg.a], &self.data[sg.b]];
             let hess = [self.hessians.get(sg.a), self.hessians.get(sg.b)];
             // Both points on a symmetry plane (a half DCB): only their upper sides have unknowns.

@@ -34,6 +34,7 @@
 pub mod assembly;
 pub mod banded;
 pub mod beam;
+pub(crate) mod changed_rows;
 pub mod corotational;
 pub mod crack;
 pub mod energy;

@@ -86,6 +86,9 @@ pub struct Newton {
     pub frozen_from_node: usize,
     /// Under displacement control, chord steps below [`CHORD_BELOW`] (on by default).
     pub(crate) chord: bool,
+    /// Whether the control unknown's row was the identity's at the last factorisation (`None`:
+    /// none succeeded since the rows' record was last started).
+    factorised_control_held: Option<bool>,
 }
 
 impl Newton {
@@ -116,6 +119,7 @@ impl Newton {
             active: n,
             frozen_from_node: usize::MAX,
             chord: true,
+            factorised_control_held: None,
         }
     }
 
@@ -140,12 +144,26 @@ impl Newton {
     }
 
     /// Factorises the tangent and solves for the residual `r` in place (and for `b` with `both`).
-    fn factorize_and_solve(&mut self, both: bool) -> Result<(), BandError> {
+    /// `control_held`: the control unknown's row and column are the identity's (displacement
+    /// control), which the rows known unchanged since the last factorisation presume as well.
+    fn factorize_and_solve(&mut self, both: bool, control_held: bool) -> Result<(), BandError> {
         match self.lu.as_mut() {
-            Some(lu) => lu.factorize(&self.k).inspect(|_| match both {
-                true => lu.solve2_in_place(&mut self.r, &mut self.b),
-                false => lu.solve_in_place(&mut self.r),
-            }),
+            Some(lu) => {
+                let within =
+                    if self.factorised_control_held == Some(control_held) { self.asm.changed.rows() } else { None };
+                let done = lu.factorize_within(&self.k, within);
+                if done.is_ok() {
+                    self.asm.changed.factorised();
+                    self.factorised_control_held = Some(control_held);
+                } else {
+                    self.asm.changed.forget();
+                    self.factorised_control_held = None;
+                }
+                done.inspect(|_| match both {
+                    true => lu.solve2_in_place(&mut self.r, &mut self.b),
+                    false => lu.solve_in_place(&mut self.r),
+                })
+            }
             None => self.k.factorize().inspect(|_| match both {
                 true => self.k.solve2_in_place(&mut self.r, &mut self.b),
                 false => self.k.solve_in_place(&mut self.r),
@@ -257,7 +275,7 @@ impl Newton {
                 self.counters.1 += 1;
                 let n = self.k.n();
                 self.k.set_order(self.active);
-                let factorized = self.factorize_and_solve(false);
+                let factorized = self.factorize_and_solve(false, true);
                 self.k.set_order(n);
                 factorized.map_err(|_| StepFailure::Singular)?;
             }
@@ -329,7 +347,7 @@ impl Newton {
             self.b[ic] = 1.0;
             let n = self.k.n();
             self.k.set_order(self.active);
-            let factorized = self.factorize_and_solve(true);
+            let factorized = self.factorize_and_solve(true, false);
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
             // Bordering: Δq = a + Δλ b, with the constraint linearised in (c, λ).

@@ -158,6 +158,17 @@ impl SpanLu {
     /// Factorises `a` (its order as set by [`BandMatrix::set_order`]), reusing the factors of the
     /// last matrix for the rows that did not change.
     pub fn factorize(&mut self, a: &BandMatrix) -> Result<(), BandError> {
+        self.factorize_within(a, None)
+    }
+
+    /// [`SpanLu::factorize`] told that only rows `lo..=hi` of `a` can differ from the last matrix
+    /// (`Some(None)`: none can; `None`: any): the changed rows are looked for there alone, and
+    /// they are the ones a search of every row finds (checked in debug builds).
+    pub(crate) fn factorize_within(
+        &mut self,
+        a: &BandMatrix,
+        within: Option<Option<(usize, usize)>>,
+    ) -> Result<(), BandError> {
         let (n, bw) = (a.n(), a.bandwidth());
         let w = 2 * bw + 1;
         if n != self.n || bw != self.bw || self.reference.len() != n * w {
@@ -179,9 +190,18 @@ impl SpanLu {
             diff.fold(0u64, |acc, (x, y)| acc | (x.to_bits() ^ y.to_bits())) == 0
         };
         let (first, last) = if self.valid {
-            match (0..n).find(|&i| !same(i)) {
+            let (lo, hi) = match within {
+                None => (0, n),
+                Some(None) => (0, 0),
+                Some(Some((lo, hi))) => (lo.min(n), (hi + 1).min(n)),
+            };
+            debug_assert!(
+                (0..lo).chain(hi..n).all(same),
+                "a row outside {lo}..{hi} changed since the last factorisation"
+            );
+            match (lo..hi).find(|&i| !same(i)) {
                 None => return Ok(()),
-                Some(first) => (first, (first..n).rev().find(|&i| !same(i)).unwrap_or(first)),
+                Some(first) => (first, (first..hi).rev().find(|&i| !same(i)).unwrap_or(first)),
             }
         } else {
             (0, n - 1)
