@@ -1,17 +1,18 @@
 //! The discrete problem and the assembly of internal forces and tangent.
 //!
 //! With small rotations the beams and springs are linear: their stiffness is assembled once per
-//! mesh into [`Assembler::linear`] and every Newton iteration only copies it and adds the interface
-//! points (one 2×2 law tangent each, at the nodes). With large rotations the co-rotational beams are
-//! re-assembled each iteration. No allocation happens per iteration: every buffer lives in the
-//! [`Assembler`].
+//! mesh into [`Assembler::linear`] and a Newton iteration only copies it and adds the interface
+//! items (points, segments) — and, where its tangent holds the last one, only in the rows of the
+//! items whose stiffness changed (`fe::changed_rows`; the rows are the same sums, in the same
+//! order, as a whole assembly's). With large rotations the co-rotational beams are re-assembled
+//! each iteration. No allocation happens per iteration: every buffer lives in the [`Assembler`].
 //!
 //! The interface is integrated by the nodal rule ([`InterfaceRule::Nodal`]: each point with its
 //! tributary area) or, between neighbouring cohesive points, by [`super::segment`]'s exact
 //! integration over a traction field with its kinks at the damage fronts
 //! ([`InterfaceRule::Segments`]).
 
-use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent};
+use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Tangent, Traction};
 
 use super::banded::{BandMatrix, RowSparse};
 use super::beam;
@@ -149,6 +150,8 @@ pub struct Assembler {
     /// What the interface scattered into the tangent, for the rows that can have changed since
     /// the last factorisation (small rotations only).
     pub(crate) changed: ChangedRows,
+    /// Whether the last tangent was rebuilt only where it changed ([`Assembler::assemble_reusing`]).
+    pub(crate) tangent_reused: bool,
 }
 
 /// Relative margin within which a cohesive point iterates with its loading-branch tangent.
@@ -245,6 +248,7 @@ impl Assembler {
             hess: Box::new([[[0.0; POINT_DOFS]; POINT_DOFS]; 2]),
             frozen_from_node: usize::MAX,
             changed,
+            tangent_reused: false,
         }
     }
 
@@ -258,9 +262,28 @@ impl Assembler {
         law: &dyn CohesiveLaw,
         states: &[LawState],
         q: &[f64],
+        k: Option<&mut BandMatrix>,
+        f: &mut [f64],
+        secant: bool,
+    ) -> bool {
+        self.assemble_reusing(p, law, states, q, k, f, secant, false)
+    }
+
+    /// [`Assembler::assemble`]; with `reuse`, a tangent `k` that holds this assembler's last one
+    /// (the caller's word that it changed since only in the identity rows and columns of
+    /// prescribed unknowns, set again before any factorisation) is rebuilt only in the rows of the
+    /// interface items that changed ([`Assembler::tangent_reused`] says whether it was).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn assemble_reusing(
+        &mut self,
+        p: &FeProblem,
+        law: &dyn CohesiveLaw,
+        states: &[LawState],
+        q: &[f64],
         mut k: Option<&mut BandMatrix>,
         f: &mut [f64],
         secant: bool,
+        reuse: bool,
     ) -> bool {
         if p.large_rotation {
             // The constant part is the springs alone: added directly rather than by copying and
@@ -280,8 +303,7 @@ impl Assembler {
                 }
             }
         } else {
-            if let Some(k) = k.as_deref_mut() {
-                k.copy_from(&self.linear);
+            if k.is_some() {
                 self.changed.start(self.frozen_from_node);
             }
             self.linear_entries.mul_vec(q, f);
@@ -353,11 +375,8 @@ impl Assembler {
                 self.data[ip] = PointData::new(kin, d);
                 continue;
             }
-            if k.is_some() && !p.large_rotation {
-                self.changed.point(ip, &d);
-            }
             let w = pt.area * pt.factor;
-            // f += w Gᵀ T ; K += w (Gᵀ D G + T_n H_n + T_t H_t)
+            // f += w Gᵀ T
             let g = &kin.grad;
             for a in 0..POINT_DOFS {
                 let da = kin.dofs[a];
@@ -365,24 +384,14 @@ impl Assembler {
                     continue;
                 }
                 f[da] += w * (g[0][a] * t[0] + g[1][a] * t[1]);
-                let Some(k) = k.as_deref_mut() else {
-                    continue;
-                };
-                // Row a of Gᵀ D: (g0a D00 + g1a D10, g0a D01 + g1a D11)
-                let ra0 = g[0][a] * d[(0, 0)] + g[1][a] * d[(1, 0)];
-                let ra1 = g[0][a] * d[(0, 1)] + g[1][a] * d[(1, 1)];
-                for b in 0..POINT_DOFS {
-                    let db = kin.dofs[b];
-                    if db == NONE {
-                        continue;
-                    }
-                    let mut v = ra0 * g[0][b] + ra1 * g[1][b];
-                    if kin.nonlinear {
-                        v += t[0] * self.hess[0][a][b] + t[1] * self.hess[1][a][b];
-                    }
-                    if v != 0.0 {
-                        k.add(da, db, w * v);
-                    }
+            }
+            // K += w (Gᵀ D G + T_n H_n + T_t H_t): at once under large rotations (the Hessian is
+            // this point's until the next), once the whole interface is known otherwise.
+            if let Some(k) = k.as_deref_mut() {
+                if p.large_rotation {
+                    scatter_point(k, &kin, &d, w, Some((&*self.hess, t)), (0, usize::MAX));
+                } else {
+                    self.changed.point(ip, &d);
                 }
             }
         }
@@ -400,19 +409,80 @@ impl Assembler {
             let sf = segment::integrate(sg, &end(sg.a), &end(sg.b), law, self.mode_one.as_ref());
             self.fronts[is] = sf.fronts;
             self.segment_stored[is] = sf.stored;
-            if k.is_some() && !p.large_rotation {
-                self.changed.segment(is, &sf.jac);
-            }
             let pts = [&self.data[sg.a], &self.data[sg.b]];
-            let hess = [self.hessians.get(sg.a), self.hessians.get(sg.b)];
             // Both points on a symmetry plane (a half DCB): only their upper sides have unknowns.
-            if pts[0].first == SIDE && pts[1].first == SIDE {
-                add_segment::<SIDE>(k.as_deref_mut(), f, pts, hess, &sf);
+            let half = on_symmetry_plane(pts);
+            if half {
+                segment_forces::<SIDE>(f, pts, &sf.f);
             } else {
-                add_segment::<0>(k.as_deref_mut(), f, pts, hess, &sf);
+                segment_forces::<0>(f, pts, &sf.f);
+            }
+            if let Some(k) = k.as_deref_mut() {
+                if p.large_rotation {
+                    let hess = [self.hessians.get(sg.a), self.hessians.get(sg.b)];
+                    let all = (0, usize::MAX);
+                    if half {
+                        scatter_segment::<SIDE>(k, pts, hess, &sf.jac, &sf.f, all);
+                    } else {
+                        scatter_segment::<0>(k, pts, hess, &sf.jac, &sf.f, all);
+                    }
+                } else {
+                    self.changed.segment(is, &sf.jac);
+                }
+            }
+        }
+        if let Some(k) = k {
+            if !p.large_rotation {
+                self.scatter_interface(p, k, reuse);
             }
         }
         ok
+    }
+
+    /// The small-rotation tangent from the interface items' stiffnesses of this assembly: the
+    /// linear part and every item's share, in the order of a whole assembly (points, then
+    /// segments). With `reuse`, where `k` holds this assembler's last tangent (the same buffer,
+    /// the same frozen node; the identity rows of prescribed unknowns the Newton iteration set in
+    /// it being set again before its factorisation), only the rows of the items that changed since
+    /// are rebuilt, from the items that write them: each row is the same sum, in the same order,
+    /// as a whole assembly's, and the others are as they were.
+    fn scatter_interface(&mut self, p: &FeProblem, k: &mut BandMatrix, reuse: bool) {
+        let same_buffer = self.changed.last_buffer(k.address(), self.frozen_from_node);
+        self.tangent_reused = reuse && same_buffer;
+        let rows = if self.tangent_reused { self.changed.rows_since_last_assembly() } else { Some((0, self.n - 1)) };
+        if let Some(rows) = rows {
+            self.rebuild_rows(p, k, rows);
+        }
+    }
+
+    /// Rows `lo..=hi` of the small-rotation tangent of the last assembly, built in `k`: the
+    /// linear part and the shares of the interface items that write them, in their order.
+    pub(crate) fn rebuild_rows(&self, p: &FeProblem, k: &mut BandMatrix, (lo, hi): (usize, usize)) {
+        if (lo, hi) == (0, self.n - 1) {
+            k.copy_from(&self.linear);
+        } else {
+            k.copy_rows_from(&self.linear, lo, hi);
+        }
+        let touches = |r: Option<(usize, usize)>| r.is_some_and(|(a, b)| a <= hi && b >= lo);
+        for (ip, pt) in p.points.iter().enumerate() {
+            if pt.node >= self.frozen_from_node || self.covered[ip] || !touches(self.changed.point_rows(ip)) {
+                continue;
+            }
+            let d = self.changed.assembled_point(ip);
+            scatter_point(k, &self.at_rest[ip], &d, pt.area * pt.factor, None, (lo, hi));
+        }
+        for (is, sg) in self.segments.iter().enumerate() {
+            if p.points[sg.b].node >= self.frozen_from_node || !touches(self.changed.segment_rows(is)) {
+                continue;
+            }
+            let pts = [&self.data[sg.a], &self.data[sg.b]];
+            let (jac, none) = (self.changed.assembled_segment(is), &[Traction::zeros(); 2]);
+            if on_symmetry_plane(pts) {
+                scatter_segment::<SIDE>(k, pts, [None, None], jac, none, (lo, hi));
+            } else {
+                scatter_segment::<0>(k, pts, [None, None], jac, none, (lo, hi));
+            }
+        }
     }
 
     /// Tangent for the iteration matrix of a cohesive point.
@@ -471,19 +541,17 @@ impl Assembler {
     }
 }
 
-/// Adds a segment's forces `G_iᵀ f_i` and tangent `G_iᵀ J_ij G_j` (plus `f_i · H_i` for a point
-/// with nonlinear kinematics) for its end points `pts`, whose unknowns are among
+/// Whether both points of a segment lie on a symmetry plane (a half DCB: only their upper sides
+/// have unknowns).
+fn on_symmetry_plane(pts: [&PointData; 2]) -> bool {
+    pts[0].first == SIDE && pts[1].first == SIDE
+}
+
+/// Adds a segment's forces `fs` (on its two points' gaps) to `f`; the points' unknowns are among
 /// `kin.dofs[FIRST..]` (a constant, so the loops unroll).
-fn add_segment<const FIRST: usize>(
-    mut k: Option<&mut BandMatrix>,
-    f: &mut [f64],
-    pts: [&PointData; 2],
-    hess: [Option<&interface::Hessian>; 2],
-    sf: &segment::SegmentForces,
-) {
-    for (i, pi) in pts.iter().enumerate() {
+fn segment_forces<const FIRST: usize>(f: &mut [f64], pts: [&PointData; 2], fs: &[Traction; 2]) {
+    for (pi, fi) in pts.iter().zip(fs) {
         let ki = &pi.kin;
-        let fi = sf.f[i];
         for r in FIRST..POINT_DOFS {
             let dr = ki.dofs[r];
             if dr == NONE {
@@ -494,13 +562,36 @@ fn add_segment<const FIRST: usize>(
                 continue;
             }
             f[dr] += g0 * fi[0] + g1 * fi[1];
-            let Some(k) = k.as_deref_mut() else {
+        }
+    }
+}
+
+/// Adds a segment's tangent `G_iᵀ J_ij G_j` (and, under large rotations, `f_i·H_i`) to the rows
+/// `rows.0..=rows.1` of `k`; the points' unknowns are among `kin.dofs[FIRST..]`.
+fn scatter_segment<const FIRST: usize>(
+    k: &mut BandMatrix,
+    pts: [&PointData; 2],
+    hess: [Option<&interface::Hessian>; 2],
+    jac: &[[Tangent; 2]; 2],
+    fs: &[Traction; 2],
+    (lo, hi): (usize, usize),
+) {
+    for (i, pi) in pts.iter().enumerate() {
+        let ki = &pi.kin;
+        let fi = fs[i];
+        for r in FIRST..POINT_DOFS {
+            let dr = ki.dofs[r];
+            if dr == NONE || dr < lo || dr > hi {
                 continue;
-            };
+            }
+            let (g0, g1) = (ki.grad[0][r], ki.grad[1][r]);
+            if g0 == 0.0 && g1 == 0.0 && !ki.nonlinear {
+                continue;
+            }
             // Row r of G_iᵀ J_ij, times G_j.
             for (j, pj) in pts.iter().enumerate() {
                 let kj = &pj.kin;
-                let jac = &sf.jac[i][j];
+                let jac = &jac[i][j];
                 let ra0 = g0 * jac[(0, 0)] + g1 * jac[(1, 0)];
                 let ra1 = g0 * jac[(0, 1)] + g1 * jac[(1, 1)];
                 let h = if i == j && ki.nonlinear { hess[i] } else { None };
@@ -517,6 +608,43 @@ fn add_segment<const FIRST: usize>(
                         k.add(dr, dc, v);
                     }
                 }
+            }
+        }
+    }
+}
+
+/// Adds a point's tangent `w (Gᵀ D G + T_n H_n + T_t H_t)` (the Hessian terms with `hess` =
+/// `Some((H, T))`, large rotations) to the rows `rows.0..=rows.1` of `k`.
+fn scatter_point(
+    k: &mut BandMatrix,
+    kin: &GapKinematics,
+    d: &Tangent,
+    w: f64,
+    hess: Option<(&interface::Hessian, Traction)>,
+    (lo, hi): (usize, usize),
+) {
+    let g = &kin.grad;
+    for a in 0..POINT_DOFS {
+        let da = kin.dofs[a];
+        if da == NONE || da < lo || da > hi || (g[0][a] == 0.0 && g[1][a] == 0.0 && !kin.nonlinear) {
+            continue;
+        }
+        // Row a of Gᵀ D: (g0a D00 + g1a D10, g0a D01 + g1a D11)
+        let ra0 = g[0][a] * d[(0, 0)] + g[1][a] * d[(1, 0)];
+        let ra1 = g[0][a] * d[(0, 1)] + g[1][a] * d[(1, 1)];
+        for b in 0..POINT_DOFS {
+            let db = kin.dofs[b];
+            if db == NONE {
+                continue;
+            }
+            let mut v = ra0 * g[0][b] + ra1 * g[1][b];
+            if kin.nonlinear {
+                if let Some((h, t)) = hess {
+                    v += t[0] * h[0][a][b] + t[1] * h[1][a][b];
+                }
+            }
+            if v != 0.0 {
+                k.add(da, db, w * v);
             }
         }
     }

@@ -127,6 +127,18 @@ impl BandMatrix {
         &self.data[i * self.width..(i + 1) * self.width]
     }
 
+    /// Copies rows `lo..=hi` of `other` (same shape) into `self`.
+    pub(crate) fn copy_rows_from(&mut self, other: &BandMatrix, lo: usize, hi: usize) {
+        debug_assert_eq!((self.n, self.bw), (other.n, other.bw));
+        let range = lo * self.width..(hi + 1) * self.width;
+        self.data[range.clone()].copy_from_slice(&other.data[range]);
+    }
+
+    /// Where its entries live: two matrices with the same address are the same buffer.
+    pub(crate) fn address(&self) -> usize {
+        self.data.as_ptr() as usize
+    }
+
     /// Sets every stored entry to zero (keeps the allocation).
     pub fn clear(&mut self) {
         self.data.fill(0.0);

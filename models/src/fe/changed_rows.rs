@@ -1,4 +1,5 @@
-//! Which rows of a small-rotation tangent can differ from those of its last factorisation.
+//! Which rows of a small-rotation tangent can differ from those of the last one assembled, and of
+//! the last one factorised.
 //!
 //! The tangent is the linear part (beams, springs: the same at every assembly) plus what every
 //! interface item scatters into the rows of its unknowns: a point under the nodal rule its
@@ -6,8 +7,10 @@
 //! or Jacobian is the same to the bit as at the last factorisation adds the same numbers in the
 //! same order, so only the rows of items that changed can differ. [`super::span_lu::SpanLu`]
 //! looks for the changed rows by comparing the whole band with its last one; told where they can
-//! be, it compares those rows alone and finds the same ones. On the ENF the rows that change lie
-//! in the process zone and at contact faces that open or close, a fifth of the band on average.
+//! be, it compares those rows alone and finds the same ones; and an assembly into the buffer of
+//! the last tangent rebuilds only the rows of items that changed since that one. On the ENF the
+//! rows that change lie in the process zone and at contact faces that open or close, a fifth of
+//! the band on average.
 
 use czid_core::Tangent;
 
@@ -26,6 +29,11 @@ pub(crate) struct ChangedRows {
     /// those of nodes before this one (the frozen node, see `Assembler::frozen_from_node`).
     assembled_frozen: usize,
     factorised_frozen: Option<usize>,
+    /// The frozen node and the buffer of the tangent assembled before this one.
+    previous_frozen: usize,
+    previous_buffer: Option<usize>,
+    /// The rows of the items whose stiffness changed since the tangent assembled before.
+    since_last: Option<(usize, usize)>,
 }
 
 /// Whether two tangents are the same to the bit (`==` would take `−0` for `0` and never a NaN
@@ -53,24 +61,70 @@ impl ChangedRows {
             factorised_segments: vec![[[Tangent::zeros(); 2]; 2]; ns],
             assembled_frozen: usize::MAX,
             factorised_frozen: None,
+            previous_frozen: usize::MAX,
+            previous_buffer: None,
+            since_last: None,
         }
     }
 
     /// A tangent's assembly starts, with the items of nodes before `frozen_from_node`.
     pub(crate) fn start(&mut self, frozen_from_node: usize) {
+        self.previous_frozen = self.assembled_frozen;
         self.assembled_frozen = frozen_from_node;
+        self.since_last = None;
     }
 
-    /// Point `ip` scattered the stiffness `d`.
+    /// Point `ip` scatters the stiffness `d`.
     #[inline]
     pub(crate) fn point(&mut self, ip: usize, d: &Tangent) {
-        self.assembled_points[ip] = *d;
+        if !same(&self.assembled_points[ip], d) {
+            widen(&mut self.since_last, self.point_rows[ip]);
+            self.assembled_points[ip] = *d;
+        }
     }
 
-    /// Segment `is` scattered the Jacobian `jac`.
+    /// Segment `is` scatters the Jacobian `jac`.
     #[inline]
     pub(crate) fn segment(&mut self, is: usize, jac: &[[Tangent; 2]; 2]) {
-        self.assembled_segments[is] = *jac;
+        let old = &self.assembled_segments[is];
+        if (0..2).any(|i| (0..2).any(|j| !same(&old[i][j], &jac[i][j]))) {
+            widen(&mut self.since_last, self.segment_rows[is]);
+            self.assembled_segments[is] = *jac;
+        }
+    }
+
+    /// Whether the tangent being assembled goes into the buffer at `address` that holds the one
+    /// assembled before, with the same frozen node; `address` is this one's from now on.
+    pub(crate) fn last_buffer(&mut self, address: usize, frozen_from_node: usize) -> bool {
+        let same = self.previous_buffer == Some(address) && self.previous_frozen == frozen_from_node;
+        self.previous_buffer = Some(address);
+        same
+    }
+
+    /// The rows of the items whose stiffness changed since the tangent assembled before (`None`:
+    /// none did).
+    pub(crate) fn rows_since_last_assembly(&self) -> Option<(usize, usize)> {
+        self.since_last
+    }
+
+    /// The rows point `ip` writes (`None` under the segment rule or without unknowns).
+    pub(crate) fn point_rows(&self, ip: usize) -> Option<(usize, usize)> {
+        self.point_rows[ip]
+    }
+
+    /// The rows segment `is` writes.
+    pub(crate) fn segment_rows(&self, is: usize) -> Option<(usize, usize)> {
+        self.segment_rows[is]
+    }
+
+    /// Point `ip`'s stiffness in the last tangent.
+    pub(crate) fn assembled_point(&self, ip: usize) -> Tangent {
+        self.assembled_points[ip]
+    }
+
+    /// Segment `is`'s Jacobian in the last tangent.
+    pub(crate) fn assembled_segment(&self, is: usize) -> &[[Tangent; 2]; 2] {
+        &self.assembled_segments[is]
     }
 
     /// The last assembled tangent was factorised.

@@ -89,6 +89,9 @@ pub struct Newton {
     /// Whether the control unknown's row was the identity's at the last factorisation (`None`:
     /// none succeeded since the rows' record was last started).
     factorised_control_held: Option<bool>,
+    /// Whether `k` carries the control unknown's identity row and column in rows the last
+    /// assembly did not rebuild.
+    control_identity_in_k: bool,
 }
 
 impl Newton {
@@ -120,10 +123,16 @@ impl Newton {
             frozen_from_node: usize::MAX,
             chord: true,
             factorised_control_held: None,
+            control_identity_in_k: false,
         }
     }
 
-    /// Assembles the internal forces, and the tangent into `k` with `tangent`.
+    /// Assembles the internal forces, and the tangent into `k` with `tangent`, rebuilt only where
+    /// the interface changed where `k` holds the last one ([`Assembler::assemble_reusing`]);
+    /// `control_held`: the control unknown's row will be the identity's (displacement control).
+    /// Where `k` carries the control's identity row from a displacement-controlled iteration, a
+    /// dissipation-controlled one, which solves for the control, assembles it whole.
+    #[allow(clippy::too_many_arguments)]
     fn assemble(
         &mut self,
         p: &FeProblem,
@@ -132,14 +141,46 @@ impl Newton {
         q: &[f64],
         secant: bool,
         tangent: bool,
+        control_held: bool,
     ) -> Result<(), StepFailure> {
         self.counters.0 += 1;
         self.asm.frozen_from_node = self.frozen_from_node;
+        let reuse = control_held || !self.control_identity_in_k;
         let k = tangent.then_some(&mut self.k);
-        if self.asm.assemble(p, law, states, q, k, &mut self.f, secant) {
+        let ok = self.asm.assemble_reusing(p, law, states, q, k, &mut self.f, secant, reuse);
+        if tangent && !self.asm.tangent_reused {
+            self.control_identity_in_k = false;
+        }
+        if ok {
             Ok(())
         } else {
             Err(StepFailure::NonFinite)
+        }
+    }
+
+    /// Debug builds: the tangent about to be factorised is the whole assembly's, identity rows
+    /// and columns included, to the bit.
+    #[cfg(debug_assertions)]
+    fn check_tangent(&self, p: &FeProblem, control_held: bool) {
+        if p.large_rotation {
+            return;
+        }
+        // The identity rows were set at the full order (the factorisation's may be smaller).
+        let mut whole = self.k.clone();
+        whole.set_order(self.asm.n());
+        self.asm.rebuild_rows(p, &mut whole, (0, self.asm.n() - 1));
+        for &d in &p.fixed {
+            whole.set_identity_row_col(d);
+        }
+        if control_held {
+            whole.set_identity_row_col(p.control);
+        }
+        for i in 0..self.asm.n() {
+            let (a, b) = (self.k.band_row(i), whole.band_row(i));
+            assert!(
+                a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "row {i} of the tangent rebuilt where it changed differs from the whole assembly's"
+            );
         }
     }
 
@@ -219,7 +260,7 @@ impl Newton {
         let mut chord_failed = false;
         while it <= max_it {
             let secant = secant_left > 0;
-            self.assemble(p, law, states, q, secant, !chord)?;
+            self.assemble(p, law, states, q, secant, !chord, true)?;
             let scale = self.scale();
             let tol = self.settings.tolerance * scale;
             let mut rmax = 0.0f64;
@@ -261,7 +302,7 @@ impl Newton {
                 // and slipping).
                 chord = false;
                 chord_failed = true;
-                self.assemble(p, law, states, q, secant, true)?;
+                self.assemble(p, law, states, q, secant, true, true)?;
             }
             if chord {
                 chord_from = rel;
@@ -272,9 +313,12 @@ impl Newton {
                     self.k.set_identity_row_col(d);
                 }
                 self.k.set_identity_row_col(p.control);
+                self.control_identity_in_k = true;
                 self.counters.1 += 1;
                 let n = self.k.n();
                 self.k.set_order(self.active);
+                #[cfg(debug_assertions)]
+                self.check_tangent(p, true);
                 let factorized = self.factorize_and_solve(false, true);
                 self.k.set_order(n);
                 factorized.map_err(|_| StepFailure::Singular)?;
@@ -313,7 +357,7 @@ impl Newton {
         let ic = p.control;
         let mut r_prev = f64::INFINITY;
         for it in 0..=self.settings.max_iterations {
-            self.assemble(p, law, states, q, false, true)?;
+            self.assemble(p, law, states, q, false, true, false)?;
             let tol = self.settings.tolerance * self.scale();
             let mut rmax = 0.0f64;
             for i in 0..q.len() {
@@ -347,6 +391,8 @@ impl Newton {
             self.b[ic] = 1.0;
             let n = self.k.n();
             self.k.set_order(self.active);
+            #[cfg(debug_assertions)]
+            self.check_tangent(p, false);
             let factorized = self.factorize_and_solve(true, false);
             self.k.set_order(n);
             factorized.map_err(|_| StepFailure::Singular)?;
