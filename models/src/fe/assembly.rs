@@ -458,11 +458,7 @@ impl Assembler {
     /// Rows `lo..=hi` of the small-rotation tangent of the last assembly, built in `k`: the
     /// linear part and the shares of the interface items that write them, in their order.
     pub(crate) fn rebuild_rows(&self, p: &FeProblem, k: &mut BandMatrix, (lo, hi): (usize, usize)) {
-        if (lo, hi) == (0, self.n - 1) {
-            k.copy_from(&self.linear);
-        } else {
-            k.copy_rows_from(&self.linear, lo, hi);
-        }
+        k.copy_rows_from(&self.linear, lo, hi);
         let touches = |r: Option<(usize, usize)>| r.is_some_and(|(a, b)| a <= hi && b >= lo);
         for (ip, pt) in p.points.iter().enumerate() {
             if pt.node >= self.frozen_from_node || self.covered[ip] || !touches(self.changed.point_rows(ip)) {

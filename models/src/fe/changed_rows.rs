@@ -14,8 +14,9 @@
 
 use czid_core::Tangent;
 
-/// The interface items' stiffnesses at the last assembly of a tangent and at the last
-/// factorisation, and the rows each item writes.
+/// The interface items' stiffnesses at the last assembly of a tangent, the rows each item
+/// writes, and the rows of the items that changed since the tangent assembled before and since the
+/// last factorisation.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ChangedRows {
     /// Per point (nodal rule) and per segment: the first and last row it writes (`None`: none).
@@ -23,17 +24,18 @@ pub(crate) struct ChangedRows {
     segment_rows: Vec<Option<(usize, usize)>>,
     assembled_points: Vec<Tangent>,
     assembled_segments: Vec<[[Tangent; 2]; 2]>,
-    factorised_points: Vec<Tangent>,
-    factorised_segments: Vec<[[Tangent; 2]; 2]>,
-    /// The items assembled since the tangent's last start, and at the last factorisation:
-    /// those of nodes before this one (the frozen node, see `Assembler::frozen_from_node`).
+    /// The items assembled: those of nodes before this one (the frozen node, see
+    /// `Assembler::frozen_from_node`), at the last assembly and at the last factorisation.
     assembled_frozen: usize,
     factorised_frozen: Option<usize>,
     /// The frozen node and the buffer of the tangent assembled before this one.
     previous_frozen: usize,
     previous_buffer: Option<usize>,
-    /// The rows of the items whose stiffness changed since the tangent assembled before.
+    /// The rows of the items whose stiffness changed since the tangent assembled before, and
+    /// since the last factorisation (an item that differs from its value then changed at one of
+    /// the assemblies since).
     since_last: Option<(usize, usize)>,
+    since_factorised: Option<(usize, usize)>,
 }
 
 /// Whether two tangents are the same to the bit (`==` would take `−0` for `0` and never a NaN
@@ -57,13 +59,12 @@ impl ChangedRows {
             segment_rows,
             assembled_points: vec![Tangent::zeros(); np],
             assembled_segments: vec![[[Tangent::zeros(); 2]; 2]; ns],
-            factorised_points: vec![Tangent::zeros(); np],
-            factorised_segments: vec![[[Tangent::zeros(); 2]; 2]; ns],
             assembled_frozen: usize::MAX,
             factorised_frozen: None,
             previous_frozen: usize::MAX,
             previous_buffer: None,
             since_last: None,
+            since_factorised: None,
         }
     }
 
@@ -78,7 +79,7 @@ impl ChangedRows {
     #[inline]
     pub(crate) fn point(&mut self, ip: usize, d: &Tangent) {
         if !same(&self.assembled_points[ip], d) {
-            widen(&mut self.since_last, self.point_rows[ip]);
+            self.changed(self.point_rows[ip]);
             self.assembled_points[ip] = *d;
         }
     }
@@ -88,9 +89,14 @@ impl ChangedRows {
     pub(crate) fn segment(&mut self, is: usize, jac: &[[Tangent; 2]; 2]) {
         let old = &self.assembled_segments[is];
         if (0..2).any(|i| (0..2).any(|j| !same(&old[i][j], &jac[i][j]))) {
-            widen(&mut self.since_last, self.segment_rows[is]);
+            self.changed(self.segment_rows[is]);
             self.assembled_segments[is] = *jac;
         }
+    }
+
+    fn changed(&mut self, rows: Option<(usize, usize)>) {
+        widen(&mut self.since_last, rows);
+        widen(&mut self.since_factorised, rows);
     }
 
     /// Whether the tangent being assembled goes into the buffer at `address` that holds the one
@@ -129,8 +135,7 @@ impl ChangedRows {
 
     /// The last assembled tangent was factorised.
     pub(crate) fn factorised(&mut self) {
-        self.factorised_points.copy_from_slice(&self.assembled_points);
-        self.factorised_segments.copy_from_slice(&self.assembled_segments);
+        self.since_factorised = None;
         self.factorised_frozen = Some(self.assembled_frozen);
     }
 
@@ -141,25 +146,9 @@ impl ChangedRows {
 
     /// The first and last row of the last assembled tangent that can differ from the last
     /// factorised one (`Some(None)`: none can), or `None` if that is not known (no factorisation
-    /// yet, or another set of items assembled). The items of frozen nodes, left out of the
-    /// assemblies since, hold the same values in both lists.
+    /// yet, or another frozen node: other items assembled).
     pub(crate) fn rows(&self) -> Option<Option<(usize, usize)>> {
-        if self.factorised_frozen != Some(self.assembled_frozen) {
-            return None;
-        }
-        let mut range = None;
-        for (ip, rows) in self.point_rows.iter().enumerate() {
-            if rows.is_some() && !same(&self.assembled_points[ip], &self.factorised_points[ip]) {
-                widen(&mut range, *rows);
-            }
-        }
-        for (is, rows) in self.segment_rows.iter().enumerate() {
-            let (a, b) = (&self.assembled_segments[is], &self.factorised_segments[is]);
-            if rows.is_some() && (0..2).any(|i| (0..2).any(|j| !same(&a[i][j], &b[i][j]))) {
-                widen(&mut range, *rows);
-            }
-        }
-        Some(range)
+        (self.factorised_frozen == Some(self.assembled_frozen)).then_some(self.since_factorised)
     }
 }
 
