@@ -54,6 +54,10 @@ impl BandRow<'_> {
 /// band of a symmetric one ([`super::symmetric_band::SymmetricBand`]), so one element routine
 /// serves both.
 pub trait StiffnessBand {
+    /// Whether only the entries on and above the diagonal are kept (a symmetric matrix's band):
+    /// [`StiffnessBand::add`] then drops the others, and callers may leave them out.
+    const UPPER_ONLY: bool = false;
+
     /// Adds `v` to entry `(i, j)`, which must lie within the band.
     fn add(&mut self, i: usize, j: usize, v: f64);
 

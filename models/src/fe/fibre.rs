@@ -358,9 +358,10 @@ pub fn scatter_tangent<K: StiffnessBand>(l: f64, d: &[[f64; 2]; 2], dofs: &[usiz
             continue;
         }
         for &(b, bb, rb) in &cols {
-            if dofs[b] != NONE {
+            let db = dofs[b];
+            if db != NONE && !(K::UPPER_ONLY && db < da) {
                 // `element`'s sum over `B D B` has this one non-zero term.
-                k.add(da, dofs[b], ba * d[ra][rb] * bb * l);
+                k.add(da, db, ba * d[ra][rb] * bb * l);
             }
         }
     }

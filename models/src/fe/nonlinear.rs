@@ -304,11 +304,15 @@ struct PointCouplings {
     forces: Vec<(usize, [f64; 2])>,
     /// Unknowns `(a, b)` and `w [g_n,a g_n,b, g_n,a g_t,b, g_t,a g_n,b, g_t,a g_t,b]`.
     pairs: Vec<(usize, usize, [f64; 4])>,
+    /// The pairs with `b ≥ a`, per point from `upper_start`: all that a symmetric band keeps.
+    upper_start: Vec<usize>,
+    upper: Vec<(usize, usize, [f64; 4])>,
 }
 
 impl PointCouplings {
     fn new(points: &[InterfacePoint], kinematics: &[interface::GapKinematics]) -> Self {
-        let mut c = PointCouplings { force_start: vec![0], pair_start: vec![0], ..Default::default() };
+        let mut c =
+            PointCouplings { force_start: vec![0], pair_start: vec![0], upper_start: vec![0], ..Default::default() };
         for (pt, kin) in points.iter().zip(kinematics) {
             let w = pt.area * pt.factor;
             let g = &kin.grad;
@@ -318,11 +322,16 @@ impl PointCouplings {
                 c.forces.push((kin.dofs[a], [w * g[0][a], w * g[1][a]]));
                 for &b in &moved {
                     let p = [g[0][a] * g[0][b], g[0][a] * g[1][b], g[1][a] * g[0][b], g[1][a] * g[1][b]];
-                    c.pairs.push((kin.dofs[a], kin.dofs[b], p.map(|v| w * v)));
+                    let pair = (kin.dofs[a], kin.dofs[b], p.map(|v| w * v));
+                    c.pairs.push(pair);
+                    if pair.1 >= pair.0 {
+                        c.upper.push(pair);
+                    }
                 }
             }
             c.force_start.push(c.forces.len());
             c.pair_start.push(c.pairs.len());
+            c.upper_start.push(c.upper.len());
         }
         c
     }
@@ -666,9 +675,11 @@ impl<'a> Solver<'a> {
             fibre::scatter_tangent(fe.len, st, &fe.dofs, k);
         }
         let cp = &self.couplings;
+        // A symmetric band drops the entries below its diagonal: only the pairs it keeps.
+        let (pairs, start) = if K::UPPER_ONLY { (&cp.upper, &cp.upper_start) } else { (&cp.pairs, &cp.pair_start) };
         for (ip, d) in self.iteration_tangents.iter().enumerate() {
             let dd = [d[(0, 0)], d[(0, 1)], d[(1, 0)], d[(1, 1)]];
-            for &(da, db, p) in &cp.pairs[cp.pair_start[ip]..cp.pair_start[ip + 1]] {
+            for &(da, db, p) in &pairs[start[ip]..start[ip + 1]] {
                 k.add(da, db, dd[0] * p[0] + dd[1] * p[1] + dd[2] * p[2] + dd[3] * p[3]);
             }
         }

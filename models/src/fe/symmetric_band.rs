@@ -264,6 +264,8 @@ impl SymmetricBand {
 }
 
 impl StiffnessBand for SymmetricBand {
+    const UPPER_ONLY: bool = true;
+
     /// Adds `v` to entry `(i, j)` when `j ≥ i`. An entry below the diagonal is not stored: the
     /// caller adds a symmetric matrix, whose mirror entry `(j, i)` carries the same value.
     #[inline]
