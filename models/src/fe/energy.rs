@@ -16,7 +16,7 @@
 use czid_core::{CohesiveLaw, Gap, LawEval, LawState, Traction};
 
 use super::interface::{InterfacePoint, PointKind};
-use super::segment::ModeOne;
+use super::segment::{Measure, ModeOne};
 
 /// Running energy totals of the simulated part (N·mm).
 #[derive(Clone, Debug, Default)]
@@ -165,14 +165,20 @@ pub(crate) fn path_work_split(
     let openings = (g0[0], g1[0]);
     if s0.damage <= 0.0 && after.damage > 0.0 {
         let onset = mode_one.map(|m| m.onset);
-        if let Some(t) = split(pure, openings, onset, &|t| law.evaluate(&at(t), s0).state.damage > 0.0) {
+        let eval = |t: f64| law.evaluate(&at(t), s0);
+        // Measured beyond the onset: the damage, which starts from zero there.
+        let measure: Measure = Some((&|e| e.state.damage, true));
+        if let Some(t) = split(pure, openings, onset, &eval, &|e| e.state.damage > 0.0, measure) {
             bp[n] = (t, exact.map(|m| m.onset_traction));
             n += 1;
         }
     }
     if s0.damage < 1.0 && after.damage >= 1.0 {
         let failure = mode_one.and_then(|m| m.failure);
-        if let Some(t) = split(pure, openings, failure, &|t| law.evaluate(&at(t), s0).state.damage >= 1.0) {
+        let eval = |t: f64| law.evaluate(&at(t), s0);
+        // Measured before failure: the intact fraction, which vanishes there.
+        let measure: Measure = Some((&|e| 1.0 - e.state.damage, false));
+        if let Some(t) = split(pure, openings, failure, &eval, &|e| e.state.damage >= 1.0, measure) {
             bp[n] = (t, exact.filter(|m| m.failure.is_some()).map(|m| m.failure_traction));
             n += 1;
         }
@@ -211,19 +217,31 @@ pub(crate) fn path_work_split(
 }
 
 /// Where along a step (a fraction of it) a point crosses a level of its path: at the law's
-/// opening `level` when the path is pure opening (exact), else by bisection on `beyond`; `None`
-/// if the step does not cross it.
-fn split(pure: bool, (a, b): (f64, f64), level: Option<f64>, beyond: &dyn Fn(f64) -> bool) -> Option<f64> {
+/// opening `level` when the path is pure opening (exact), else where `beyond` switches for the
+/// law's response `eval` along the step (to round-off with a `measure` of the distance to it,
+/// [`super::switch_point`]; by 60 halvings without); `None` if the step does not cross it.
+fn split(
+    pure: bool,
+    (a, b): (f64, f64),
+    level: Option<f64>,
+    eval: &dyn Fn(f64) -> LawEval,
+    beyond: &dyn Fn(&LawEval) -> bool,
+    measure: Measure,
+) -> Option<f64> {
     if let (true, Some(g)) = (pure, level) {
         if (a - g) * (b - g) < 0.0 {
             return Some((g - a) / (b - a));
         }
         return None;
     }
-    if beyond(0.0) || !beyond(1.0) {
+    let (e0, e1) = (eval(0.0), eval(1.0));
+    if beyond(&e0) || !beyond(&e1) {
         return None;
     }
-    Some(super::segment::bisect_halvings(0.0, 1.0, 60, beyond))
+    Some(match measure {
+        Some(_) => super::segment::switch_along(&e0, &e1, eval, beyond, measure),
+        None => super::segment::bisect_halvings(0.0, 1.0, 60, |t| beyond(&eval(t))),
+    })
 }
 
 /// Adds to the breakpoints `bp[..n]` of [`path_work_split`] the law's first `count` inner kinks
@@ -246,8 +264,9 @@ fn inner_kink_breakpoints(
     for k in 0..count {
         if !law.beyond_inner_kink(s0, k) && law.beyond_inner_kink(after, k) {
             let kink = mode_one.and_then(|m| m.inner[k]);
-            let beyond = |t: f64| law.beyond_inner_kink(&law.evaluate(&(g0 + dg * t), s0).state, k);
-            if let Some(t) = split(pure, openings, kink.map(|(g, _, _)| g), &beyond) {
+            let eval = |t: f64| law.evaluate(&(g0 + dg * t), s0);
+            let beyond = |e: &LawEval| law.beyond_inner_kink(&e.state, k);
+            if let Some(t) = split(pure, openings, kink.map(|(g, _, _)| g), &eval, &beyond, None) {
                 bp[n] = (t, kink.filter(|_| pure).map(|(_, traction, _)| traction));
                 n += 1;
             }

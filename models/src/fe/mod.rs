@@ -49,6 +49,7 @@ pub(crate) mod pool;
 pub mod run_types;
 pub mod segment;
 pub mod span_lu;
+pub(crate) mod switch_point;
 pub mod symmetric_band;
 pub(crate) mod window;
 

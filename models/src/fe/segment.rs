@@ -38,6 +38,7 @@ use czid_core::{CohesiveLaw, Gap, LawState, Tangent, Traction};
 
 use super::interface::{InterfacePoint, PointKind};
 use super::mesh::Mesh;
+use super::switch_point::switch_point;
 
 /// The interface between two cohesive points of the same layers at neighbouring nodes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -285,7 +286,9 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
                 (true, Some(m)) => fixed_opening(a, b, m.onset, m.onset_traction, &m.onset_tangent),
                 _ => {
                     let init = law.initial_state();
-                    located(a, b, &|g| law.evaluate(g, &init), |e| e.state.damage > 0.0, !da, true)
+                    // Measured beyond the onset: the damage, which starts from zero there.
+                    let measure: Measure = Some((&|e| e.state.damage, true));
+                    located(a, b, &|g| law.evaluate(g, &init), |e| e.state.damage > 0.0, measure, !da, true)
                 }
             };
         }
@@ -296,7 +299,11 @@ pub fn integrate(s: &Segment, a: &End, b: &End, law: &dyn CohesiveLaw, mode_one:
         let other = if fa { b } else { a };
         kinks[1] = match (pure_one, mode_one.and_then(|m| m.failure.map(|g| (g, m)))) {
             (true, Some((g, m))) => fixed_opening(a, b, g, m.failure_traction, &m.failure_tangent),
-            _ => located(a, b, &|g| law.evaluate(g, other.state), |e| e.state.damage >= 1.0, !fa, false),
+            _ => {
+                // Measured before failure: the intact fraction, which vanishes there.
+                let measure: Measure = Some((&|e| 1.0 - e.state.damage, false));
+                located(a, b, &|g| law.evaluate(g, other.state), |e| e.state.damage >= 1.0, measure, !fa, false)
+            }
         };
     }
     // The law's inner kinks, where it has any (most laws have none: no work for them here).
@@ -416,7 +423,15 @@ fn inner_fronts(
         let other = if ka { b } else { a };
         *slot = match (pure_one, mode_one.and_then(|m| m.inner[k])) {
             (true, Some((g, t, d))) => fixed_opening(a, b, g, t, &d),
-            _ => located(a, b, &|g| law.evaluate(g, other.state), |e| law.beyond_inner_kink(&e.state, k), !ka, false),
+            _ => located(
+                a,
+                b,
+                &|g| law.evaluate(g, other.state),
+                |e| law.beyond_inner_kink(&e.state, k),
+                None,
+                !ka,
+                false,
+            ),
         };
     }
     fronts.iter().any(Option::is_some).then_some(fronts)
@@ -455,7 +470,30 @@ fn front_tangents(k: &Tangent, eta: f64, dg: Gap, deta: &[[f64; 2]; 2]) -> [Tang
     dt
 }
 
-/// A front located by bisection along the segment: `beyond` holds for the law's response at the
+/// A continuous measure of the law's response that vanishes at a front, and whether it is taken
+/// beyond the front (else before it): it lets [`switch_point`] find the front in fewer evaluations
+/// than bisection, at the same place. `None`: bisection.
+pub(crate) type Measure<'a> = Option<(&'a dyn Fn(&czid_core::LawEval) -> f64, bool)>;
+
+/// The front where `beyond` switches along `s` in `[0, 1]`, false at 0 and true at 1, from the
+/// responses `e0`, `e1` there: [`switch_point`] with the measure, else bisection.
+pub(crate) fn switch_along(
+    e0: &czid_core::LawEval,
+    e1: &czid_core::LawEval,
+    eval_at: impl Fn(f64) -> czid_core::LawEval,
+    beyond: impl Fn(&czid_core::LawEval) -> bool,
+    measure: Measure,
+) -> f64 {
+    match measure {
+        Some((m, measured_beyond)) => switch_point(0.0, 1.0, measured_beyond, [m(e0), m(e1)], |s| {
+            let e = eval_at(s);
+            (beyond(&e), m(&e))
+        }),
+        None => bisect(0.0, 1.0, |s| beyond(&eval_at(s))),
+    }
+}
+
+/// A front located along the segment: `beyond` holds for the law's response at the
 /// end `a` (if `from_a` is false, at `b`) and not at the other. Its derivatives need the normal to
 /// the front in gap space: the gradient of the damage on the side where it varies (`grows_beyond`:
 /// beyond the front for the onset, before it for failure), by central differences; the radial
@@ -465,16 +503,18 @@ fn located(
     b: &End,
     eval: &dyn Fn(&Gap) -> czid_core::LawEval,
     beyond: impl Fn(&czid_core::LawEval) -> bool,
+    measure: Measure,
     from_a: bool,
     grows_beyond: bool,
 ) -> Option<Front> {
     let gap = |eta: f64| a.gap * (1.0 - eta) + b.gap * eta;
     // Orient the search so that `beyond` is false at 0 and true at 1 in `s`.
     let to_eta = |s: f64| if from_a { s } else { 1.0 - s };
-    if beyond(&eval(&gap(to_eta(0.0)))) || !beyond(&eval(&gap(to_eta(1.0)))) {
+    let (e0, e1) = (eval(&gap(to_eta(0.0))), eval(&gap(to_eta(1.0))));
+    if beyond(&e0) || !beyond(&e1) {
         return None;
     }
-    let s = bisect(0.0, 1.0, |s| beyond(&eval(&gap(to_eta(s)))));
+    let s = switch_along(&e0, &e1, |s| eval(&gap(to_eta(s))), &beyond, measure);
     let eta = to_eta(s);
     if !(eta > 0.0 && eta < 1.0) {
         return None;
@@ -512,15 +552,17 @@ fn located(
 
 /// Where along the segment between points with gaps `ga`, `gb` and committed states `sa`, `sb`
 /// the damage reaches `level` (a fraction from `a`), if one end is at or above it and the other
-/// below: bisection on the law evaluated from the less damaged end's state (the material between
-/// loaded monotonically, as for the failure front).
+/// below: located on the law evaluated from the less damaged end's state (the material between
+/// loaded monotonically, as for the failure front), by [`switch_point`] on how far the damage is
+/// from the level.
 pub fn level_front(law: &dyn CohesiveLaw, ga: Gap, gb: Gap, sa: &LawState, sb: &LawState, level: f64) -> Option<f64> {
-    front_where(law, ga, gb, sa, sb, |st| st.damage >= level)
+    // Measured before the front: how far the damage is from the level.
+    front_where(law, ga, gb, sa, sb, |st| st.damage >= level, Some(&|e: &czid_core::LawEval| level - e.state.damage))
 }
 
 /// As [`level_front`], where the law passes its inner kink `k` ([`CohesiveLaw::beyond_inner_kink`]).
 pub fn kink_front(law: &dyn CohesiveLaw, ga: Gap, gb: Gap, sa: &LawState, sb: &LawState, k: usize) -> Option<f64> {
-    front_where(law, ga, gb, sa, sb, |st| law.beyond_inner_kink(st, k))
+    front_where(law, ga, gb, sa, sb, |st| law.beyond_inner_kink(st, k), None)
 }
 
 /// Where along the segment the state reached from the end that is not `beyond` becomes so.
@@ -531,21 +573,24 @@ fn front_where(
     sa: &LawState,
     sb: &LawState,
     beyond_at: impl Fn(&LawState) -> bool,
+    before: Option<&dyn Fn(&czid_core::LawEval) -> f64>,
 ) -> Option<f64> {
-    let (ba, bb) = (beyond_at(&law.evaluate(&ga, sa).state), beyond_at(&law.evaluate(&gb, sb).state));
+    let (ea, eb) = (law.evaluate(&ga, sa), law.evaluate(&gb, sb));
+    let (ba, bb) = (beyond_at(&ea.state), beyond_at(&eb.state));
     if ba == bb {
         return None;
     }
-    let (from, state) = if !ba { (0.0, sa) } else { (1.0, sb) };
+    let (from, state, e0) = if !ba { (0.0, sa, ea) } else { (1.0, sb, eb) };
     let gap = |eta: f64| ga * (1.0 - eta) + gb * eta;
-    let beyond = |s: f64| {
+    let eval_at = |s: f64| {
         let eta = if from == 0.0 { s } else { 1.0 - s };
-        beyond_at(&law.evaluate(&gap(eta), state).state)
+        law.evaluate(&gap(eta), state)
     };
-    if !beyond(1.0) {
+    let e1 = eval_at(1.0);
+    if !beyond_at(&e1.state) {
         return None;
     }
-    let s = bisect(0.0, 1.0, beyond);
+    let s = switch_along(&e0, &e1, eval_at, |e| beyond_at(&e.state), before.map(|m| (m, false)));
     Some(if from == 0.0 { s } else { 1.0 - s })
 }
 
