@@ -168,7 +168,7 @@ pub(crate) fn path_work_split(
         let eval = |t: f64| law.evaluate(&at(t), s0);
         // Measured beyond the onset: the damage, which starts from zero there.
         let measure: Measure = Some((&|e| e.state.damage, true));
-        if let Some(t) = split(pure, openings, onset, &eval, &|e| e.state.damage > 0.0, measure) {
+        if let Some(t) = split(pure, openings, onset, eval, |e| e.state.damage > 0.0, measure) {
             bp[n] = (t, exact.map(|m| m.onset_traction));
             n += 1;
         }
@@ -178,7 +178,7 @@ pub(crate) fn path_work_split(
         let eval = |t: f64| law.evaluate(&at(t), s0);
         // Measured before failure: the intact fraction, which vanishes there.
         let measure: Measure = Some((&|e| 1.0 - e.state.damage, false));
-        if let Some(t) = split(pure, openings, failure, &eval, &|e| e.state.damage >= 1.0, measure) {
+        if let Some(t) = split(pure, openings, failure, eval, |e| e.state.damage >= 1.0, measure) {
             bp[n] = (t, exact.filter(|m| m.failure.is_some()).map(|m| m.failure_traction));
             n += 1;
         }
@@ -220,12 +220,13 @@ pub(crate) fn path_work_split(
 /// opening `level` when the path is pure opening (exact), else where `beyond` switches for the
 /// law's response `eval` along the step (to round-off with a `measure` of the distance to it,
 /// [`super::switch_point`]; by 60 halvings without); `None` if the step does not cross it.
+#[inline]
 fn split(
     pure: bool,
     (a, b): (f64, f64),
     level: Option<f64>,
-    eval: &dyn Fn(f64) -> LawEval,
-    beyond: &dyn Fn(&LawEval) -> bool,
+    eval: impl Fn(f64) -> LawEval,
+    beyond: impl Fn(&LawEval) -> bool,
     measure: Measure,
 ) -> Option<f64> {
     if let (true, Some(g)) = (pure, level) {
@@ -234,8 +235,12 @@ fn split(
         }
         return None;
     }
-    let (e0, e1) = (eval(0.0), eval(1.0));
-    if beyond(&e0) || !beyond(&e1) {
+    let e0 = eval(0.0);
+    if beyond(&e0) {
+        return None;
+    }
+    let e1 = eval(1.0);
+    if !beyond(&e1) {
         return None;
     }
     Some(match measure {
@@ -266,7 +271,7 @@ fn inner_kink_breakpoints(
             let kink = mode_one.and_then(|m| m.inner[k]);
             let eval = |t: f64| law.evaluate(&(g0 + dg * t), s0);
             let beyond = |e: &LawEval| law.beyond_inner_kink(&e.state, k);
-            if let Some(t) = split(pure, openings, kink.map(|(g, _, _)| g), &eval, &beyond, None) {
+            if let Some(t) = split(pure, openings, kink.map(|(g, _, _)| g), eval, beyond, None) {
                 bp[n] = (t, kink.filter(|_| pure).map(|(_, traction, _)| traction));
                 n += 1;
             }

@@ -510,8 +510,12 @@ fn located(
     let gap = |eta: f64| a.gap * (1.0 - eta) + b.gap * eta;
     // Orient the search so that `beyond` is false at 0 and true at 1 in `s`.
     let to_eta = |s: f64| if from_a { s } else { 1.0 - s };
-    let (e0, e1) = (eval(&gap(to_eta(0.0))), eval(&gap(to_eta(1.0))));
-    if beyond(&e0) || !beyond(&e1) {
+    let e0 = eval(&gap(to_eta(0.0)));
+    if beyond(&e0) {
+        return None;
+    }
+    let e1 = eval(&gap(to_eta(1.0)));
+    if !beyond(&e1) {
         return None;
     }
     let s = switch_along(&e0, &e1, |s| eval(&gap(to_eta(s))), &beyond, measure);
