@@ -472,7 +472,8 @@ fn front_tangents(k: &Tangent, eta: f64, dg: Gap, deta: &[[f64; 2]; 2]) -> [Tang
 
 /// A continuous measure of the law's response that vanishes at a front, and whether it is taken
 /// beyond the front (else before it): it lets [`switch_point`] find the front in fewer evaluations
-/// than bisection, at the same place. `None`: bisection.
+/// than bisection, at the same place where the response switches once along the way. `None`:
+/// bisection.
 pub(crate) type Measure<'a> = Option<(&'a dyn Fn(&czid_core::LawEval) -> f64, bool)>;
 
 /// The front where `beyond` switches along `s` in `[0, 1]`, false at 0 and true at 1, from the
