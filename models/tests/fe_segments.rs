@@ -286,3 +286,50 @@ fn debonded_length_follows_the_damage_threshold() {
     assert!((a.debonded + a.process_zone - b.debonded - b.process_zone).abs() < 1e-9);
     assert!((b.debonded - c.debonded).abs() < 1e-6);
 }
+
+#[test]
+fn mixed_mode_fronts_are_where_bisection_puts_them() {
+    // The debonded-length front along a segment, found by the secant search on how far the damage
+    // is from the level, against bisection to round-off on the same yes/no question, on the B-K
+    // bilinear law over mixed-mode segments: the same float wherever the damage crosses the level
+    // once, and never more than a few units in the last place apart.
+    let law = Bilinear::bk(1e5, 20.0, 40.0, 0.5, 1.5, 2.0).unwrap();
+    // Mode I onset opening σ_n/K (mm).
+    let onset = 20.0 / 1e5;
+    let (mut same, mut cases) = (0, 0);
+    for k in 0..400 {
+        let f = |i: u32| ((k * 7919 + i as usize * 104_729) % 1000) as f64 / 1000.0;
+        // One end inside the process zone or beyond, the other nearer the elastic limit.
+        let ga = Gap::new(onset * (1.0 + 40.0 * f(1)), onset * 3.0 * (f(2) - 0.3));
+        let gb = Gap::new(onset * (0.5 + 4.0 * f(3)), onset * 2.0 * (f(4) - 0.5));
+        let virgin = LawState::default();
+        let (sa, sb) = (virgin, virgin);
+        for level in [1e-9, 0.3, 0.9, 1.0 - 1e-9] {
+            let Some(eta) = fe::segment::level_front(&law, ga, gb, &sa, &sb, level) else { continue };
+            // Bisection as the front was found before, from the less damaged end.
+            let beyond = |g: Gap, s: &LawState| law.evaluate(&g, s).state.damage >= level;
+            let a_short = !beyond(ga, &sa);
+            let gap = |eta: f64| ga * (1.0 - eta) + gb * eta;
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            loop {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                let e = if a_short { mid } else { 1.0 - mid };
+                if beyond(gap(e), if a_short { &sa } else { &sb }) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            let expected = if a_short { lo } else { 1.0 - lo };
+            cases += 1;
+            same += usize::from(eta.to_bits() == expected.to_bits());
+            assert!((eta - expected).abs() <= 8.0 * f64::EPSILON, "case {k}, level {level}: {eta} against {expected}");
+        }
+    }
+    println!("{same} of {cases} fronts at bisection's float");
+    assert!(cases > 400, "{cases} fronts only");
+    assert!(same * 10 >= cases * 9, "{same} of {cases} at bisection's float");
+}
