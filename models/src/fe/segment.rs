@@ -558,7 +558,7 @@ fn located(
 /// Where along the segment between points with gaps `ga`, `gb` and committed states `sa`, `sb`
 /// the damage reaches `level` (a fraction from `a`), if one end is at or above it and the other
 /// below: located on the law evaluated from the less damaged end's state (the material between
-/// loaded monotonically, as for the failure front), by [`switch_point`] on how far the damage is
+/// loaded monotonically, as for the failure front), by a secant search on how far the damage is
 /// from the level.
 pub fn level_front(law: &dyn CohesiveLaw, ga: Gap, gb: Gap, sa: &LawState, sb: &LawState, level: f64) -> Option<f64> {
     // Measured before the front: how far the damage is from the level.
