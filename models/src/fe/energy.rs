@@ -243,9 +243,10 @@ fn split(
     if !beyond(&e1) {
         return None;
     }
-    Some(match measure {
-        Some(_) => super::segment::switch_along(&e0, &e1, eval, beyond, measure),
-        None => super::segment::bisect_halvings(0.0, 1.0, 60, |t| beyond(&eval(t))),
+    Some(if measure.is_some() {
+        super::segment::switch_along(&e0, &e1, eval, beyond, measure)
+    } else {
+        super::segment::bisect_halvings(0.0, 1.0, 60, |t| beyond(&eval(t)))
     })
 }
 
