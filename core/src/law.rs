@@ -136,6 +136,20 @@ pub trait CohesiveLaw: Send + Sync + std::fmt::Debug {
         false
     }
 
+    /// A key of the law's response to pure opening (default `None`: not known). Two laws of one
+    /// type with equal keys agree to the bit, at every gap `(g_n, 0)` reached through such gaps
+    /// from the initial state, on the normal traction, the damage, the tangent's normal entry and
+    /// the stored energy, and give a zero shear traction and finite values elsewhere; the normal
+    /// components of [`CohesiveLaw::fracture_energy`], [`CohesiveLaw::strength`] and
+    /// [`CohesiveLaw::initial_stiffness`] are equal too. The key holds the bits of every value
+    /// that response depends on: for a law whose modes interact only through the mode mix, those
+    /// of its normal branch. A test that opens the interface without shearing it (a symmetric
+    /// DCB) then runs alike with either law, whatever their shear branches, and an identification
+    /// answers the one from the other ([`crate::ForwardModel::law_key`]).
+    fn mode_one_key(&self) -> Option<Vec<u64>> {
+        None
+    }
+
     /// The law with a fibre-bridging tail added (an R-curve): a long, weak part of strength
     /// `strength` (MPa) that vanishes at opening `opening` (mm), superposed on this law; `None`
     /// when the law has no such extension (default). At `strength = 0` the law itself.

@@ -56,6 +56,18 @@ pub trait ForwardModel: Send + Sync + std::fmt::Debug {
         Ok(Vec::new())
     }
 
+    /// A key of what a run takes from `law` (default `None`: every law counts as different).
+    /// Runs of this model with laws of one type and equal keys give the same record, or the same
+    /// failure, to the bit: a model that loads the interface in pure opening only returns its
+    /// law's [`CohesiveLaw::mode_one_key`] and whatever else of the law its run depends on. An
+    /// identification evaluates a candidate whose every experiment has the key of one evaluated
+    /// before by taking that one's value (the shear branch a DCB cannot see, moved by a genetic
+    /// algorithm, does not cost a run).
+    fn law_key(&self, law: &dyn CohesiveLaw) -> Option<Vec<u64>> {
+        let _ = law;
+        None
+    }
+
     /// The model's switchable effects (default: none). Each declared field must exist in the
     /// model's configuration, and at the declared null value the model must simulate exactly as
     /// without the effect; the diagnosis builds its candidate effects from these declarations.

@@ -364,6 +364,19 @@ impl ForwardModel for Dcb {
         })
     }
 
+    /// The half model (small rotations, no compliance in series with the law) opens its
+    /// interface without shearing it: its gaps' shear component and gradient are exact zeros, so
+    /// the run takes from the law its response to pure opening and the window's elastic box.
+    fn law_key(&self, law: &dyn CohesiveLaw) -> Option<Vec<u64>> {
+        let plain = self.symmetry == Symmetry::Half && !self.effects.large_rotation;
+        if !plain || !matches!(self.interface_law(law), Ok(None)) {
+            return None;
+        }
+        let mut key = law.mode_one_key()?;
+        key.extend(crate::fe::window::opening_key(law)?);
+        Some(key)
+    }
+
     fn simulate(&self, law: &dyn CohesiveLaw) -> std::result::Result<Record, SimulationFailure> {
         let fail = |error: CzError| SimulationFailure { error, partial: beamtest::new_record() };
         let series = self.interface_law(law).map_err(fail)?;

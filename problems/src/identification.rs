@@ -10,7 +10,10 @@ use czid_core::{
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap, VecDeque};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
 
 use crate::data::Experiment;
 
@@ -248,6 +251,48 @@ pub struct Identification {
     setup: Setup,
     space: ParameterSpace,
     fits: Vec<Fit>,
+    /// Evaluations of recent candidates by what their runs took from them.
+    answered: Mutex<Answered>,
+}
+
+/// Memory the evaluations kept for reuse may take (bytes): on the paper's DCB about 1,000 of
+/// them, which hold nearly all the candidates a genetic algorithm makes again (most within the
+/// last hundred evaluations).
+const ANSWERED_BYTES: usize = 16 << 20;
+
+/// Recent evaluations by the key of what their runs took from the candidate
+/// ([`Identification::key`]), the oldest forgotten first.
+#[derive(Debug, Default)]
+struct Answered {
+    by_key: HashMap<Vec<u64>, Evaluation>,
+    order: VecDeque<Vec<u64>>,
+    bytes: usize,
+}
+
+impl Answered {
+    fn size(key: &[u64], e: &Evaluation) -> usize {
+        8 * (2 * key.len() + e.objectives.len() + e.residuals.len() + 1)
+    }
+
+    fn insert(&mut self, key: Vec<u64>, e: Evaluation) {
+        let size = Answered::size(&key, &e);
+        if size > ANSWERED_BYTES || self.by_key.contains_key(&key) {
+            return;
+        }
+        while self.bytes + size > ANSWERED_BYTES {
+            let Some(old) = self.order.pop_front() else { break };
+            if let Some(gone) = self.by_key.remove(&old) {
+                self.bytes -= Answered::size(&old, &gone);
+            }
+        }
+        self.bytes += size;
+        self.order.push_back(key.clone());
+        self.by_key.insert(key, e);
+    }
+
+    fn clear(&mut self) {
+        *self = Answered::default();
+    }
 }
 
 impl Identification {
@@ -311,7 +356,7 @@ impl Identification {
         }
         // Fail early, with the path named, if a parameter does not exist in the setup.
         space.read(&setup)?;
-        Ok(Identification { setup, space, fits })
+        Ok(Identification { setup, space, fits, answered: Mutex::default() })
     }
 
     /// The parameter space.
@@ -344,6 +389,8 @@ impl Identification {
     /// equally and the objective is 1 (the paper's choice of α); an event's term then has its
     /// `weight` times that.
     pub fn balance_weights(&mut self) -> Result<()> {
+        // Evaluations made with the old weights are no longer this problem's.
+        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
         let x0 = self.initial()?;
         let outcome = self.simulate(&x0)?;
         let parts: Vec<Vec<f64>> = self
@@ -370,6 +417,8 @@ impl Identification {
     /// worth beside a coarse one (debonded lengths read with a ruler). An event without an
     /// `uncertainty` is an error.
     pub fn noise_weights(&mut self) -> Result<()> {
+        // Evaluations made with the old weights are no longer this problem's.
+        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
         for fit in &mut self.fits {
             let mut w = Vec::with_capacity(fit.kinds.len());
             for (((term, kind), factor), u) in
@@ -399,6 +448,8 @@ impl Identification {
 
     /// Sets α_E of every event term (times the event's own `weight`); the curve terms keep theirs.
     pub fn set_event_weight(&mut self, alpha_e: f64) -> Result<()> {
+        // Evaluations made with the old weights are no longer this problem's.
+        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
         for fit in &mut self.fits {
             let mut w = fit.objective.weights();
             for ((w, k), f) in w.iter_mut().zip(&fit.kinds).zip(&fit.factors) {
@@ -416,6 +467,8 @@ impl Identification {
 
     /// Sets the weights of the load and debonded-length terms (α_F, α_L) for every experiment.
     pub fn set_weights(&mut self, alpha_f: f64, alpha_l: f64) -> Result<()> {
+        // Evaluations made with the old weights are no longer this problem's.
+        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
         for fit in &mut self.fits {
             let w: Vec<f64> = fit
                 .kinds
@@ -460,10 +513,14 @@ impl Identification {
     /// specimen ([`scored_as_broken`]), so the optimizer sees a large but finite value; a run with
     /// fewer than two steps is an error.
     pub fn simulate(&self, x: &[f64]) -> Result<Outcome> {
-        let setup = self.configure(x)?;
+        self.simulate_setup(&self.configure(x)?)
+    }
+
+    /// [`Identification::simulate`] of a configured setup.
+    fn simulate_setup(&self, setup: &Setup) -> Result<Outcome> {
         let kinds = self.term_kinds();
         let names: Vec<&str> = self.fits.iter().map(|f| f.name.as_str()).collect();
-        let Runs { records, failures, failed } = simulate_experiments(&setup, &names)?;
+        let Runs { records, failures, failed } = simulate_experiments(setup, &names)?;
         let mut outcome = Outcome {
             evaluation: Evaluation { value: 0.0, objectives: Vec::new(), residuals: Vec::new() },
             records,
@@ -485,6 +542,76 @@ impl Identification {
         }
         outcome.evaluation = Evaluation { value, objectives, residuals };
         Ok(outcome)
+    }
+
+    /// The setup at unit-cube point `u` and its [`Identification::key`].
+    fn prepare(&self, u: &[f64]) -> Result<(Setup, Option<Vec<u64>>)> {
+        let x = self.space.from_unit(u);
+        let setup = self.configure(&x)?;
+        let key = self.key(&setup, &x);
+        Ok((setup, key))
+    }
+
+    /// The evaluation of `setup`: kept from a candidate with the same `key`, or run (the time
+    /// the runs take added to `nanos`, ns) and kept.
+    fn answer(&self, setup: &Setup, key: Option<Vec<u64>>, nanos: &AtomicU64) -> Result<Evaluation> {
+        let answered = || self.answered.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = key.as_ref().and_then(|k| answered().by_key.get(k).cloned()) {
+            return Ok(e);
+        }
+        let t = Instant::now();
+        let e = self.simulate_setup(setup).map(|o| o.evaluation);
+        nanos.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        if let (Some(k), Ok(e)) = (key, &e) {
+            answered().insert(k, e.clone());
+        }
+        e
+    }
+
+    /// [`Problem::evaluate_batch`], with the time its runs take added to `nanos` (ns). Candidates
+    /// with equal keys are run once, by the first of them.
+    pub(crate) fn evaluate_batch_timed(&self, us: &[Vec<f64>], nanos: &AtomicU64) -> Vec<Result<Evaluation>> {
+        let prepared: Vec<Result<(Setup, Option<Vec<u64>>)>> = us.par_iter().map(|u| self.prepare(u)).collect();
+        let source: Vec<Option<usize>> = {
+            let mut first: HashMap<&[u64], usize> = HashMap::new();
+            prepared
+                .iter()
+                .enumerate()
+                .map(|(k, p)| match p {
+                    Ok((_, Some(key))) => Some(*first.entry(key.as_slice()).or_insert(k)).filter(|&f| f != k),
+                    _ => None,
+                })
+                .collect()
+        };
+        let mut out: Vec<Option<Result<Evaluation>>> = prepared
+            .into_par_iter()
+            .zip(&source)
+            .map(|(p, from)| from.is_none().then(|| p.and_then(|(setup, key)| self.answer(&setup, key, nanos))))
+            .collect();
+        for (k, from) in source.iter().enumerate() {
+            if let Some(f) = *from {
+                out[k] = out[f].clone();
+            }
+        }
+        out.into_iter().map(|e| e.expect("every candidate answered")).collect()
+    }
+
+    /// What the runs of `setup` (configured at `x`) take from the candidate, where every
+    /// experiment's model can say ([`ForwardModel::law_key`]): the models' keys of the law, then
+    /// the values of the parameters outside the law. `None` where a model cannot say.
+    fn key(&self, setup: &Setup, x: &[f64]) -> Option<Vec<u64>> {
+        let mut key = Vec::new();
+        for fit in &self.fits {
+            let k = setup.models.get(&fit.name)?.law_key(setup.law.as_ref())?;
+            key.push(k.len() as u64);
+            key.extend(k);
+        }
+        for (p, v) in self.space.parameters().iter().zip(x) {
+            if !p.path.starts_with("law.") {
+                key.push(v.to_bits());
+            }
+        }
+        Some(key)
     }
 
     /// Unweighted `||φ||²` per experiment and term, e.g. `("F:dcb", 1.2e-4)`.
@@ -526,9 +653,18 @@ impl Problem for Identification {
         vec![(0.0, 1.0); self.space.dim()]
     }
 
+    /// A candidate whose runs take from it what an earlier one's took (every experiment's
+    /// [`ForwardModel::law_key`], the parameters outside the law) gets that one's evaluation: the
+    /// runs would give the same records to the bit.
     fn evaluate(&self, u: &[f64]) -> Result<Evaluation> {
-        let x = self.space.from_unit(u);
-        Ok(self.simulate(&x)?.evaluation)
+        let (setup, key) = self.prepare(u)?;
+        self.answer(&setup, key, &AtomicU64::new(0))
+    }
+
+    /// [`Identification::evaluate`] for a batch, where a candidate with the key of an earlier
+    /// one in the batch takes that one's evaluation too.
+    fn evaluate_batch(&self, us: &[Vec<f64>]) -> Vec<Result<Evaluation>> {
+        self.evaluate_batch_timed(us, &AtomicU64::new(0))
     }
 
     fn objectives(&self) -> usize {

@@ -137,6 +137,9 @@ impl Problem for Timed<'_> {
         self.nanos.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         r
     }
+    fn evaluate_batch(&self, xs: &[Vec<f64>]) -> Vec<Result<Evaluation>> {
+        self.inner.evaluate_batch_timed(xs, &self.nanos)
+    }
     fn objectives(&self) -> usize {
         self.inner.objectives()
     }

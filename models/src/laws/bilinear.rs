@@ -217,6 +217,14 @@ impl CohesiveLaw for Bilinear {
         [self.strength_n, self.strength_t]
     }
 
+    /// With the B-K criterion, the penalty, the normal strength and `G_Ic`: at zero slip the mode
+    /// mix is an exact zero, so is its power, and `G_c = G_Ic` to the bit. The power law's
+    /// `G_c`, a power and its inverse, keeps `η` in its last digits: no key.
+    fn mode_one_key(&self) -> Option<Vec<u64>> {
+        (self.criterion == MixedModeCriterion::Bk)
+            .then(|| vec![self.penalty.to_bits(), self.strength_n.to_bits(), self.g_ic.to_bits()])
+    }
+
     fn with_bridging_tail(&self, strength: f64, opening: f64) -> Option<Result<Box<dyn CohesiveLaw>>> {
         Some(if strength == 0.0 {
             // The null: the law itself, not a superposition with an empty part.

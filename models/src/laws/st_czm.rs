@@ -216,6 +216,16 @@ impl CohesiveLaw for StCzm {
         [self.strength_n, self.strength_t]
     }
 
+    /// The normal branch and both shapes: at zero slip the shear terms of the strength surface,
+    /// `(a_t/δ_t)²`, are exact zeros, and the shear branch enters nothing else of the normal
+    /// response (the shear shape is in the key all the same: it may add inner kinks).
+    fn mode_one_key(&self) -> Option<Vec<u64>> {
+        let mut key = vec![self.strength_n.to_bits(), self.u_e_n.to_bits(), self.u_c_n.to_bits()];
+        key.extend(self.shape_n.key());
+        key.extend(self.shape_t.key());
+        Some(key)
+    }
+
     fn parameters(&self) -> Vec<ParameterInfo> {
         let mut list = vec![
             ParameterInfo {

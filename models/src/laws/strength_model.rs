@@ -40,6 +40,18 @@ pub enum StrengthShape {
 }
 
 impl StrengthShape {
+    /// The shape as bits, for a law's [`czid_core::CohesiveLaw::mode_one_key`]: its kind, then
+    /// its numbers (zeros where it has fewer).
+    pub(crate) fn key(&self) -> [u64; 3] {
+        match *self {
+            StrengthShape::Sawtooth => [0, 0, 0],
+            StrengthShape::Exponential { alpha } => [1, alpha.to_bits(), 0],
+            StrengthShape::Trilinear { kink_fraction, kink_strength_ratio } => {
+                [2, kink_fraction.to_bits(), kink_strength_ratio.to_bits()]
+            }
+        }
+    }
+
     /// Whether this is the default (sawtooth) shape; such shapes are left out of written files.
     pub fn is_sawtooth(&self) -> bool {
         *self == StrengthShape::Sawtooth

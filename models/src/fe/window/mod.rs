@@ -102,6 +102,17 @@ impl Unfit {
 /// Why a windowed run gave up, and the state it reached when the whole mesh can go on from it.
 pub(crate) type GaveUp = (Unfit, Option<Box<Resume>>);
 
+/// The bits of what a windowed run of a problem whose gaps have no shear takes from `law`
+/// besides its evaluations at such gaps: the opening extent of the elastic box the condensed
+/// regions' gaps are checked against, which is found on mixed gaps (`None` where the law has no
+/// box, and the whole mesh would run). Its shear extent, `−h ≤ 0 ≤ h` with `h > 0`, decides
+/// nothing at a zero shear gap. Such a model adds them to its law's
+/// [`czid_core::CohesiveLaw::mode_one_key`].
+pub(crate) fn opening_key(law: &dyn CohesiveLaw) -> Option<[u64; 2]> {
+    let lin = linear_domain(law, &ModeOne::of(law)?)?;
+    Some([lin.lo[0].to_bits(), lin.hi[0].to_bits()])
+}
+
 /// Solves `p` along `s` with the window; the rows at the output abscissae. A run that gives up
 /// where the path turns back or the window reaches the far end also returns its last committed
 /// state, for the whole mesh to go on from.
