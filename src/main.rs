@@ -378,9 +378,13 @@ fn run_identify(
     if res.partial {
         println!("interrupted: best so far in {}; continue with --resume", dir.file("result.partial.json").display());
     }
-    let repeated = match res.repeated_evaluations {
-        0 => String::new(),
-        n => format!(" ({n} of them points evaluated before, not run again)"),
+    let repeated = match (res.repeated_evaluations, res.shared_evaluations) {
+        (0, 0) => String::new(),
+        (n, 0) => format!(" ({n} of them points evaluated before, not run again)"),
+        (0, m) => format!(" ({m} of them answered from points whose runs are the same)"),
+        (n, m) => format!(
+            " ({n} of them points evaluated before and {m} points whose runs are the same as another's, not run)"
+        ),
     };
     println!(
         "objective f = {:.4e} after {} evaluations{repeated} in {:.1} s",

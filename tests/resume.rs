@@ -36,7 +36,7 @@ fn identify_file(problem: &str, out: &Path, optimizer: &str, budget: &str, extra
 fn result(dir: &Path) -> serde_json::Value {
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap();
-    for k in ["wall_seconds", "forward_share", "resumed"] {
+    for k in ["wall_seconds", "forward_share", "resumed", "shared_evaluations"] {
         v.as_object_mut().unwrap().remove(k);
     }
     v

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::collections::{BTreeMap, BTreeSet, HashMap, VecDeque};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -253,6 +253,8 @@ pub struct Identification {
     fits: Vec<Fit>,
     /// Evaluations of recent candidates by what their runs took from them.
     answered: Mutex<Answered>,
+    /// Evaluations answered so from another candidate's.
+    shared: AtomicUsize,
 }
 
 /// Memory the evaluations kept for reuse may take (bytes): on the paper's DCB about 1,000 of
@@ -356,7 +358,7 @@ impl Identification {
         }
         // Fail early, with the path named, if a parameter does not exist in the setup.
         space.read(&setup)?;
-        Ok(Identification { setup, space, fits, answered: Mutex::default() })
+        Ok(Identification { setup, space, fits, answered: Mutex::default(), shared: AtomicUsize::new(0) })
     }
 
     /// The parameter space.
@@ -544,6 +546,12 @@ impl Identification {
         Ok(outcome)
     }
 
+    /// How many evaluations were answered from another candidate's, whose runs take the same from
+    /// it ([`ForwardModel::law_key`]), instead of running the forward models.
+    pub fn shared_evaluations(&self) -> usize {
+        self.shared.load(Ordering::Relaxed)
+    }
+
     /// The setup at unit-cube point `u` and its [`Identification::key`].
     fn prepare(&self, u: &[f64]) -> Result<(Setup, Option<Vec<u64>>)> {
         let x = self.space.from_unit(u);
@@ -557,6 +565,7 @@ impl Identification {
     fn answer(&self, setup: &Setup, key: Option<Vec<u64>>, nanos: &AtomicU64) -> Result<Evaluation> {
         let answered = || self.answered.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(e) = key.as_ref().and_then(|k| answered().by_key.get(k).cloned()) {
+            self.shared.fetch_add(1, Ordering::Relaxed);
             return Ok(e);
         }
         let t = Instant::now();
@@ -590,6 +599,7 @@ impl Identification {
             .collect();
         for (k, from) in source.iter().enumerate() {
             if let Some(f) = *from {
+                self.shared.fetch_add(1, Ordering::Relaxed);
                 out[k] = out[f].clone();
             }
         }

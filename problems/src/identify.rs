@@ -105,6 +105,11 @@ pub struct IdentifyResult {
     /// algorithm's child equal to a member).
     #[serde(default)]
     pub repeated_evaluations: usize,
+    /// Evaluations answered from another candidate's whose forward runs take the same from it,
+    /// without running them (a symmetric DCB's candidates that differ only in the law's shear
+    /// branch; `ForwardModel::law_key`), in this process's part of the run.
+    #[serde(default)]
+    pub shared_evaluations: usize,
     /// Wall time of the optimisation (s).
     pub wall_seconds: f64,
     /// Share of the run's CPU time (wall time × worker threads) spent in forward simulations.
@@ -453,6 +458,7 @@ pub fn identify(problem: &LoadedProblem, opts: &RunOptions, out: &OutputDir) -> 
         evaluations: result.evaluations,
         failed_evaluations: result.failures,
         repeated_evaluations: result.repeats,
+        shared_evaluations: id.shared_evaluations(),
         wall_seconds: wall,
         forward_share: forward_seconds / (run.wall_seconds.max(1e-12) * rayon::current_num_threads() as f64),
         resumed: clock.resumed(),
