@@ -391,8 +391,7 @@ impl Identification {
     /// equally and the objective is 1 (the paper's choice of α); an event's term then has its
     /// `weight` times that.
     pub fn balance_weights(&mut self) -> Result<()> {
-        // Evaluations made with the old weights are no longer this problem's.
-        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
+        self.forget_answers();
         let x0 = self.initial()?;
         let outcome = self.simulate(&x0)?;
         let parts: Vec<Vec<f64>> = self
@@ -419,8 +418,7 @@ impl Identification {
     /// worth beside a coarse one (debonded lengths read with a ruler). An event without an
     /// `uncertainty` is an error.
     pub fn noise_weights(&mut self) -> Result<()> {
-        // Evaluations made with the old weights are no longer this problem's.
-        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
+        self.forget_answers();
         for fit in &mut self.fits {
             let mut w = Vec::with_capacity(fit.kinds.len());
             for (((term, kind), factor), u) in
@@ -450,8 +448,7 @@ impl Identification {
 
     /// Sets α_E of every event term (times the event's own `weight`); the curve terms keep theirs.
     pub fn set_event_weight(&mut self, alpha_e: f64) -> Result<()> {
-        // Evaluations made with the old weights are no longer this problem's.
-        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
+        self.forget_answers();
         for fit in &mut self.fits {
             let mut w = fit.objective.weights();
             for ((w, k), f) in w.iter_mut().zip(&fit.kinds).zip(&fit.factors) {
@@ -469,8 +466,7 @@ impl Identification {
 
     /// Sets the weights of the load and debonded-length terms (α_F, α_L) for every experiment.
     pub fn set_weights(&mut self, alpha_f: f64, alpha_l: f64) -> Result<()> {
-        // Evaluations made with the old weights are no longer this problem's.
-        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
+        self.forget_answers();
         for fit in &mut self.fits {
             let w: Vec<f64> = fit
                 .kinds
@@ -550,6 +546,12 @@ impl Identification {
     /// it ([`ForwardModel::law_key`]), instead of running the forward models.
     pub fn shared_evaluations(&self) -> usize {
         self.shared.load(Ordering::Relaxed)
+    }
+
+    /// Forgets the evaluations kept for reuse: made with the old weights, they are no longer this
+    /// problem's.
+    fn forget_answers(&mut self) {
+        self.answered.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
     }
 
     /// The setup at unit-cube point `u` and its [`Identification::key`].
